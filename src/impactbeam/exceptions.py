@@ -1,0 +1,46 @@
+"""Exceptions raised by impactbeam.
+
+Every exception derives from :class:`ImpactBeamError` and from the built-in
+exception that fits its meaning, so ``except ValueError`` keeps working.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "ImpactBeamError",
+    "ParameterError",
+    "ScenarioError",
+    "ModeSolveError",
+    "SimulationError",
+]
+
+
+class ImpactBeamError(Exception):
+    """Base class of every error raised by impactbeam."""
+
+
+class ParameterError(ImpactBeamError, ValueError):
+    """A parameter has a value outside its valid range.
+
+    The message names the parameter, the value received and what was expected.
+    """
+
+
+class ScenarioError(ParameterError):
+    """A scenario, sweep or record file is invalid.
+
+    ``key`` holds the dotted path of the offending field (``contactors.0.gap``)
+    when there is one.
+    """
+
+    def __init__(self, message: str, key: str | None = None) -> None:
+        super().__init__(message)
+        self.key = key
+
+
+class ModeSolveError(ImpactBeamError, RuntimeError):
+    """The modal analysis could not isolate or refine a natural frequency."""
+
+
+class SimulationError(ImpactBeamError, RuntimeError):
+    """The time integration could not be completed."""

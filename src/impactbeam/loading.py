@@ -1,0 +1,196 @@
+"""Excitations and initial conditions (paper section 2, eqs. 8-10).
+
+An :class:`Excitation` is a load history ``f(x, t) = p(x) u(t)``: a spatial
+distribution ``p`` (uniform over the beam, or a point at ``position``) times a
+time history ``u(t)``. Base acceleration ``ug''(t)`` is the distributed load
+``-rho A ug''(t)``. The time history is one of
+
+* ``half_sine``: ``A sin(pi (t - start)/duration)`` for ``start <= t <= start + duration``;
+* ``step``: ``A`` for ``t >= start``;
+* ``table``: samples ``(t_k, u_k)`` held constant (the paper's rectangular steps)
+  or linear between samples (first-order hold), shifted by ``start``; zero outside.
+
+Every shape is integrated in closed form by the solver: the half-sine exactly,
+the table exactly for the hold chosen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from ._validation import choice, finite, nonnegative_finite, positive_finite
+from .exceptions import ParameterError
+
+__all__ = ["Excitation", "InitialCondition", "ExcitationKind", "ExcitationShape", "Hold"]
+
+ExcitationKind = Literal["base_acceleration", "point_force", "distributed_force", "none"]
+ExcitationShape = Literal["half_sine", "step", "table"]
+Hold = Literal["constant", "linear"]
+
+UNITS = {"base_acceleration": "m/s^2", "point_force": "N", "distributed_force": "N/m", "none": ""}
+
+
+@dataclass(frozen=True, eq=False)
+class Excitation:
+    """A load history acting on the beam.
+
+    Parameters
+    ----------
+    kind : {"base_acceleration", "point_force", "distributed_force", "none"}
+    shape : {"half_sine", "step", "table"}
+    amplitude : float
+        Peak value: [m/s^2] for base acceleration, [N] point force, [N/m]
+        distributed force. Positive along +w. For ``table`` the tabulated
+        values are used as given and ``amplitude`` is ignored.
+    duration : float or None, [s]
+        Pulse length (half_sine only).
+    start : float, [s]
+        When the pulse, step or table begins.
+    position : float or None, [m]
+        Point of application (point_force only).
+    times, values : ndarray or None
+        The table (shape ``table``): strictly increasing times [s] (relative to
+        ``start``) and values in the unit of ``kind``.
+    hold : {"constant", "linear"}
+        How a table is held between samples.
+    scale : float
+        Factor applied to the whole history (for fits and sweeps of "pulse scale").
+    """
+
+    kind: ExcitationKind = "none"
+    shape: ExcitationShape = "half_sine"
+    amplitude: float = 0.0
+    duration: float | None = None
+    start: float = 0.0
+    position: float | None = None
+    times: np.ndarray | None = field(default=None, repr=False)
+    values: np.ndarray | None = field(default=None, repr=False)
+    hold: Hold = "constant"
+    scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        choice("excitation.kind", self.kind, tuple(UNITS))
+        choice("excitation.shape", self.shape, ("half_sine", "step", "table"))
+        choice("excitation.hold", self.hold, ("constant", "linear"))
+        object.__setattr__(self, "amplitude", finite("excitation.amplitude", self.amplitude))
+        object.__setattr__(self, "start", nonnegative_finite("excitation.start", self.start))
+        object.__setattr__(self, "scale", finite("excitation.scale", self.scale))
+        if self.kind == "none":
+            return
+        if self.shape == "half_sine":
+            if self.duration is None:
+                raise ParameterError("excitation.duration: required for a half_sine pulse")
+            object.__setattr__(self, "duration", positive_finite("excitation.duration", self.duration))
+        if self.kind == "point_force":
+            if self.position is None:
+                raise ParameterError("excitation.position: required for a point_force")
+            object.__setattr__(self, "position", nonnegative_finite("excitation.position", self.position))
+        if self.shape == "table":
+            if self.times is None or self.values is None:
+                raise ParameterError("excitation.file: a table excitation needs times and values")
+            t = np.asarray(self.times, dtype=float)
+            v = np.asarray(self.values, dtype=float)
+            if t.ndim != 1 or t.shape != v.shape or t.size < 2:
+                raise ParameterError("excitation.file: need at least two (time, value) rows")
+            if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+                raise ParameterError("excitation.file: the table holds NaN or infinite values")
+            if np.any(np.diff(t) <= 0.0):
+                raise ParameterError("excitation.file: times must be strictly increasing")
+            t.setflags(write=False)
+            v.setflags(write=False)
+            object.__setattr__(self, "times", t)
+            object.__setattr__(self, "values", v)
+
+    @property
+    def unit(self) -> str:
+        """Unit of the time history values."""
+        return UNITS[self.kind]
+
+    @property
+    def active(self) -> bool:
+        """False when there is no load at all."""
+        return self.kind != "none" and self.scale != 0.0
+
+    def end_time(self) -> float:
+        """Time after which the load is zero (inf for a step)."""
+        if not self.active:
+            return 0.0
+        if self.shape == "half_sine":
+            assert self.duration is not None
+            return self.start + self.duration
+        if self.shape == "step":
+            return math.inf
+        assert self.times is not None
+        return self.start + float(self.times[-1])
+
+    def history(self, t: np.ndarray) -> np.ndarray:
+        """The time history ``u(t)`` (including ``scale``) at times ``t``, vectorised."""
+        t = np.asarray(t, dtype=float)
+        out = np.zeros_like(t)
+        if not self.active:
+            return out
+        tau = t - self.start
+        if self.shape == "half_sine":
+            assert self.duration is not None
+            inside = (tau >= 0.0) & (tau <= self.duration)
+            out[inside] = self.amplitude * np.sin(np.pi * tau[inside] / self.duration)
+        elif self.shape == "step":
+            out[tau >= 0.0] = self.amplitude
+        else:
+            assert self.times is not None and self.values is not None
+            tk, vk = self.times, self.values
+            inside = (tau >= tk[0]) & (tau <= tk[-1])
+            if self.hold == "linear":
+                out[inside] = np.interp(tau[inside], tk, vk)
+            else:
+                idx = np.clip(np.searchsorted(tk, tau[inside], side="right") - 1, 0, tk.size - 1)
+                out[inside] = vk[idx]
+        return self.scale * out
+
+
+@dataclass(frozen=True, eq=False)
+class InitialCondition:
+    """Initial state of the beam (at rest unless given).
+
+    Parameters
+    ----------
+    tip_displacement : float or None, [m]
+        Release from the static shape of a point load at ``position`` (default
+        the right end) that gives this deflection there (paper Case 0/13).
+    position : float or None, [m]
+        Where ``tip_displacement`` is imposed; default: the beam's right end.
+    modal_displacement, modal_velocity : sequence of float or None
+        Free-state modal coordinates ``eta_n(0)`` [m kg^0.5] and their rates.
+    """
+
+    tip_displacement: float | None = None
+    position: float | None = None
+    modal_displacement: tuple[float, ...] | None = None
+    modal_velocity: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.tip_displacement is not None:
+            object.__setattr__(
+                self, "tip_displacement", finite("initial.tip_displacement", self.tip_displacement)
+            )
+        if self.position is not None:
+            object.__setattr__(self, "position", nonnegative_finite("initial.position", self.position))
+        for name in ("modal_displacement", "modal_velocity"):
+            val = getattr(self, name)
+            if val is not None:
+                object.__setattr__(
+                    self, name, tuple(finite(f"initial.{name}[{i}]", v) for i, v in enumerate(val))
+                )
+
+    @property
+    def at_rest(self) -> bool:
+        """True when the beam starts undeformed and still."""
+        return (
+            self.tip_displacement in (None, 0.0)
+            and not any(self.modal_displacement or ())
+            and not any(self.modal_velocity or ())
+        )
