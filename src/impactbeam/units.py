@@ -1,0 +1,257 @@
+"""Physical quantities in scenario files: numbers (SI) or strings with units.
+
+A scenario value is either a plain number, taken as SI, or a string with a
+unit that :mod:`pint` understands (``"0.229 mm"``, ``"15 ms"``, ``"1834 MPa"``,
+``"4030 N/m"``). Two conventions go beyond pint:
+
+* for accelerations, ``g`` means standard gravity, 9.80665 m/s^2
+  (``"15 g"``, ``"0.5 g"``); pint's own ``g`` is the gram;
+* ``"inf"`` (or ``"infinity"``) is accepted for stiffnesses only, meaning rigid.
+
+NaN is rejected everywhere. Every error is a :class:`~impactbeam.exceptions.ScenarioError`
+whose message starts with the dotted key of the field, names the value received
+and the unit expected, e.g.::
+
+    excitation.amplitude: "15 kg" is a mass, expected an acceleration (m/s^2)
+
+The pint registry is created on first use (it takes a noticeable fraction of a
+second), so importing this module is cheap.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Any
+
+from .exceptions import ScenarioError
+
+__all__ = ["DIMENSIONS", "STANDARD_GRAVITY", "to_si", "unit_scale", "describe_dimension", "registry"]
+
+#: Standard gravity [m/s^2] (the "g" of accelerations).
+STANDARD_GRAVITY = 9.80665
+
+
+@dataclass(frozen=True)
+class _Dimension:
+    si_unit: str  # as written for users
+    pint_unit: str  # as given to pint
+    noun: str  # "an acceleration"
+
+
+#: The physical dimensions a scenario field can have, with their SI unit.
+DIMENSIONS: dict[str, _Dimension] = {
+    "length": _Dimension("m", "m", "a length"),
+    "stiffness": _Dimension("N/m", "N/m", "a stiffness"),
+    "rotational_stiffness": _Dimension("N m/rad", "N*m/rad", "a rotational stiffness"),
+    "modulus": _Dimension("Pa", "Pa", "a modulus"),
+    "density": _Dimension("kg/m^3", "kg/m^3", "a density"),
+    "area": _Dimension("m^2", "m^2", "an area"),
+    "second_moment": _Dimension("m^4", "m^4", "a second moment of area"),
+    "time": _Dimension("s", "s", "a time"),
+    "acceleration": _Dimension("m/s^2", "m/s^2", "an acceleration"),
+    "force": _Dimension("N", "N", "a force"),
+    "force_per_length": _Dimension("N/m", "N/m", "a force per length"),
+    "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
+}
+
+_STIFFNESSES = {"stiffness", "rotational_stiffness"}
+
+# Names for the dimensionality of a string that did not match, for the message.
+_KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
+    ("m", "a length"),
+    ("kg", "a mass"),
+    ("s", "a time"),
+    ("m^2", "an area"),
+    ("m^3", "a volume"),
+    ("m^4", "a second moment of area"),
+    ("m/s", "a velocity"),
+    ("m/s^2", "an acceleration"),
+    ("N", "a force"),
+    ("N/m", "a stiffness or force per length"),
+    ("Pa", "a pressure or modulus"),
+    ("J", "an energy or moment (N m)"),
+    ("kg/m^3", "a density"),
+    ("kg/m", "a mass per length"),
+    ("Hz", "a frequency"),
+    ("W", "a power"),
+    ("dimensionless", "a dimensionless number"),
+    ("K", "a temperature"),
+    ("A", "an electric current"),
+    ("V", "a voltage"),
+)
+
+_UREG: Any = None
+_NUMBER_START = re.compile(r"^\s*[-+]?(\d|\.\d)")
+_GRAVITY_G = re.compile(r"(?<![\w.])g(?![\w.])")
+
+
+def registry() -> Any:
+    """The module's pint ``UnitRegistry``, created on first use."""
+    global _UREG
+    if _UREG is None:
+        import pint
+
+        _UREG = pint.UnitRegistry()
+    return _UREG
+
+
+class _UnitProblem(Exception):
+    """A conversion problem; the message lacks the key, which the caller adds."""
+
+
+def describe_dimension(dimension: str) -> str:
+    """``"an acceleration (m/s^2)"``: the expected kind of quantity, for messages."""
+    dim = _dimension(dimension)
+    return f"{dim.noun} ({dim.si_unit})" if dim.si_unit else dim.noun
+
+
+def _dimension(dimension: str) -> _Dimension:
+    try:
+        return DIMENSIONS[dimension]
+    except KeyError:
+        raise ValueError(
+            f"unknown dimension {dimension!r}; expected one of {', '.join(DIMENSIONS)}"
+        ) from None
+
+
+def _name_of(dimensionality: Any) -> str:
+    ureg = registry()
+    for unit, noun in _KNOWN_DIMENSIONALITIES:
+        if ureg.parse_units(unit).dimensionality == dimensionality:
+            return noun
+    return f"of dimension {dimensionality}"
+
+
+def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
+    """Convert a pint quantity to the SI unit of ``dimension``."""
+    ureg = registry()
+    dim = _dimension(dimension)
+    target = ureg.parse_units(dim.pint_unit)
+    if quantity.dimensionality != target.dimensionality:
+        raise _UnitProblem(
+            f'"{text}" is {_name_of(quantity.dimensionality)}, expected {describe_dimension(dimension)}'
+        )
+    return float(quantity.to(target).magnitude)
+
+
+def _parse(text: str, dimension: str) -> Any:
+    """Parse ``text`` with pint (``g`` = standard gravity for accelerations)."""
+    ureg = registry()
+    expr = text
+    if dimension == "acceleration":
+        expr = _GRAVITY_G.sub("g_0", expr)
+    try:
+        quantity = ureg.parse_expression(expr)
+    except Exception as exc:  # pint raises many types (UndefinedUnitError, tokenize, ...)
+        detail = str(exc).strip() or type(exc).__name__
+        raise _UnitProblem(
+            f'cannot read "{text}" ({detail}); expected {describe_dimension(dimension)}'
+        ) from None
+    if not hasattr(quantity, "dimensionality"):  # a bare number
+        quantity = ureg.Quantity(quantity)
+    return quantity
+
+
+def _convert(value: Any, dimension: str) -> float:
+    dim = _dimension(dimension)
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        kind = type(value).__name__
+        if isinstance(value, bool):
+            kind = "a boolean"
+        elif isinstance(value, (list, tuple)):
+            kind = "a list"
+        elif isinstance(value, dict):
+            kind = "a table"
+        raise _UnitProblem(
+            f"expected a number or a string with units ({dim.si_unit or 'dimensionless'}), "
+            f"got {kind} {value!r}"
+        )
+    if isinstance(value, str):
+        text = value.strip()
+        low = text.lower()
+        if low in {"inf", "+inf", "infinity", "+infinity", "rigid"}:
+            if dimension in _STIFFNESSES:
+                return math.inf
+            raise _UnitProblem(
+                f'"{value}" is not allowed here: expected a finite value, {describe_dimension(dimension)}'
+            )
+        if low in {"nan", "+nan", "-nan"}:
+            raise _UnitProblem(f'NaN is not a valid value (expected {describe_dimension(dimension)})')
+        try:
+            out = float(text)  # a number written as a string: SI
+        except ValueError:
+            if not _NUMBER_START.match(text):
+                raise _UnitProblem(
+                    f'cannot read "{value}": expected a number followed by a unit, '
+                    f"{describe_dimension(dimension)}"
+                ) from None
+            out = _quantity_to_si(_parse(text, dimension), text, dimension)
+    else:
+        out = float(value)
+    if math.isnan(out):
+        raise _UnitProblem(f"NaN is not a valid value (expected {describe_dimension(dimension)})")
+    if math.isinf(out) and dimension not in _STIFFNESSES:
+        raise _UnitProblem(f"must be finite, got {value!r}")
+    return out
+
+
+def to_si(value: Any, dimension: str, key: str) -> float:
+    """Return ``value`` in SI units as a float.
+
+    Parameters
+    ----------
+    value : int, float or str
+        A plain number (taken as SI) or a string with a unit, e.g. ``"0.229 mm"``,
+        ``"15 g"`` (standard gravity, for accelerations), ``"1834 MPa"``.
+    dimension : str
+        One of :data:`DIMENSIONS`: ``"length"``, ``"stiffness"`` (N/m),
+        ``"rotational_stiffness"`` (N m/rad), ``"modulus"`` (Pa), ``"density"``
+        (kg/m^3), ``"area"``, ``"second_moment"``, ``"time"``, ``"acceleration"``,
+        ``"force"``, ``"force_per_length"``, ``"dimensionless"``.
+    key : str
+        Dotted name of the field, used in error messages.
+
+    Returns
+    -------
+    float
+        The value in the SI unit of ``dimension``; ``inf`` only for stiffnesses
+        given as ``inf`` or ``"inf"``.
+
+    Raises
+    ------
+    ScenarioError
+        For NaN, an infinite non-stiffness, an unreadable string or a unit of
+        the wrong dimension; ``key`` is set and starts the message.
+
+    Examples
+    --------
+    >>> to_si("15 g", "acceleration", "excitation.amplitude")
+    147.09975
+    >>> to_si("0.229 mm", "length", "contactors.0.gap")
+    0.000229
+    """
+    try:
+        return _convert(value, dimension)
+    except _UnitProblem as exc:
+        raise ScenarioError(f"{key}: {exc}", key=key) from None
+
+
+def unit_scale(unit: str, dimension: str, key: str) -> float:
+    """Factor that converts values in ``unit`` to the SI unit of ``dimension``.
+
+    ``unit_scale("ms", "time", k)`` is 1e-3; ``unit_scale("g", "acceleration", k)``
+    is 9.80665. Used for column headers such as ``time [ms]``. Raises
+    :class:`ScenarioError` (with ``key``) for an unknown unit or a wrong dimension.
+    """
+    text = unit.strip()
+    try:
+        if not text:
+            raise _UnitProblem(f"empty unit; expected {describe_dimension(dimension)}")
+        out = _quantity_to_si(_parse(text, dimension), text, dimension)
+    except _UnitProblem as exc:
+        raise ScenarioError(f"{key}: {exc}", key=key) from None
+    if not (math.isfinite(out) and out != 0.0):
+        raise ScenarioError(f'{key}: unit "{unit}" has no finite, non-zero scale', key=key)
+    return out
