@@ -52,6 +52,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 import scipy.linalg as sla
+from scipy.linalg.lapack import dpotrs as potrs
 from scipy.optimize import brentq
 
 __all__ = [
@@ -64,6 +65,7 @@ __all__ = [
     "fe_transient",
     "hermite_shape",
     "solve_modes",
+    "strain_energy",
 ]
 
 
@@ -163,6 +165,7 @@ class FEModel:
         support and interior springs) and consistent mass.
     free : int array of the free (not constrained) full DOF indices.
     K_r, M_r : the reduced matrices ``K[free][:, free]``, ``M[free][:, free]``.
+    spring_diag : (n_dof,) the finite spring stiffnesses added to diag(K).
     """
 
     length: float
@@ -174,6 +177,7 @@ class FEModel:
     free: np.ndarray
     K_r: np.ndarray = field(repr=False)
     M_r: np.ndarray = field(repr=False)
+    spring_diag: np.ndarray = field(repr=False, default=None)
 
     @property
     def n_nodes(self) -> int:
@@ -275,12 +279,14 @@ def assemble(
         K[sl, sl] += ke
         M[sl, sl] += me
     constrained: set[int] = set()
+    spring_diag = np.zeros(2 * n)
 
     def add(dof: int, k: float) -> None:
         if math.isinf(k):
             constrained.add(dof)
         else:
             K[dof, dof] += k
+            spring_diag[dof] += k
 
     k1, kt1 = (_check_spring(v, "left support") for v in left)
     k2, kt2 = (_check_spring(v, "right support") for v in right)
@@ -294,19 +300,19 @@ def assemble(
     free = np.array(sorted(set(range(2 * n)) - constrained), dtype=int)
     K_r = K[np.ix_(free, free)].copy()
     M_r = M[np.ix_(free, free)].copy()
-    return FEModel(float(length), float(EI), float(rhoA), x, K, M, free, K_r, M_r)
+    spring_diag[sorted(constrained)] = 0.0
+    return FEModel(float(length), float(EI), float(rhoA), x, K, M, free, K_r, M_r, spring_diag)
 
 
 # --------------------------------------------------------------------------
 # Modes
 # --------------------------------------------------------------------------
 def _eig_all(K_r: np.ndarray, M_r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All eigenpairs, mass-normalised, omega^2 clipped (rigid modes -> 0).
+    """All eigenpairs of (K_r, M_r) by plain ``eigh``, mass-normalised.
 
-    An eigenvalue is taken as a rigid-body one (set to 0) when it is below
-    1e-10 x the largest eigenvalue times machine-precision-scale noise; in
-    practice eigh returns |lambda| ~ eps * lambda_max for a true zero, and
-    the threshold used is 1e3 * eps * lambda_max.
+    Used for the damping matrices, where the last digits of the low
+    eigenvalues do not matter.  omega^2 below 1e3 eps lambda_max (round-off
+    level of a true zero for this algorithm) is set to 0.
     """
     lam, phi = sla.eigh(K_r, M_r)
     lam_max = max(abs(lam[-1]), np.finfo(float).tiny)
@@ -314,17 +320,63 @@ def _eig_all(K_r: np.ndarray, M_r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lam, phi
 
 
+def strain_energy(model: FEModel, u: np.ndarray) -> np.ndarray:
+    """Strain energy 1/2 u^T K u of full DOF vector(s) ``u`` (n_dof[, k]), cancellation-free.
+
+    ``u^T K u`` of a smooth vector loses ~ (L/h)^4 of the 16 digits to
+    cancellation (200 elements: ~1e-7 relative).  Here the element energy is
+    computed from the curvature, linear along a Hermite element:
+    ``kappa(0) = (6 d - 4 t_i - 2 t_j)/l``, ``kappa(l) = (-6 d + 2 t_i + 4 t_j)/l``
+    with ``d = (w_j - w_i)/l``, and ``EI/2 int kappa^2 = EI l/6 (k0^2 + k0 k1 + k1^2)``;
+    plus ``1/2 k u^2`` of the finite support / interior springs.
+    """
+    u = np.asarray(u, dtype=float)
+    w, th = u[0::2], u[1::2]
+    l = np.diff(model.x)
+    if u.ndim == 2:
+        l = l[:, None]
+    d = (w[1:] - w[:-1]) / l
+    k0 = (6 * d - 4 * th[:-1] - 2 * th[1:]) / l
+    k1 = (-6 * d + 2 * th[:-1] + 4 * th[1:]) / l
+    beam = model.EI * np.sum(l / 6.0 * (k0 * k0 + k0 * k1 + k1 * k1), axis=0)
+    sp = model.spring_diag if u.ndim == 1 else model.spring_diag[:, None]
+    return beam + 0.5 * np.sum(sp * u * u, axis=0)
+
+
 def solve_modes(model: FEModel, n_modes: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Natural frequencies and full-DOF mass-normalised mode vectors.
+
+    Eigenvectors from the shifted inverse problem ``eigh(M_r, K_r + s M_r)``
+    (s = EI/(rhoA L^4), so the low modes, which matter, are the well-resolved
+    end of the spectrum and rigid modes are harmless); eigenvalues then from
+    the Rayleigh quotient ``2 U(phi) / phi^T M phi`` with the cancellation-free
+    :func:`strain_energy`.  The Rayleigh quotient is stationary, so the
+    vector's round-off enters squared: omega of a smooth mode is accurate to
+    ~1e-12 instead of ~eps (L/h)^4.  omega^2 < 1e-10 s is a rigid-body mode,
+    reported as exactly 0.
 
     Returns ``(omega, Phi)`` with ``omega`` (n_modes,) in rad/s ascending and
     ``Phi`` (n_dof, n_modes) full DOF vectors, ``Phi^T M Phi = I``.  Sign
     convention: the nodal ``w`` of largest magnitude is positive.
     """
-    lam, phi = _eig_all(model.K_r, model.M_r)
-    if n_modes is not None:
-        lam, phi = lam[:n_modes], phi[:, :n_modes]
+    s = model.EI / (model.rhoA * model.length**4)
+    nf = len(model.free)
+    B = model.K_r + s * model.M_r
+    if n_modes is not None and n_modes + 4 < nf:
+        # the n_modes + 4 largest mu (margin for re-ordering after refinement)
+        mu, phi = sla.eigh(model.M_r, B, subset_by_index=[nf - n_modes - 4, nf - 1])
+    else:
+        mu, phi = sla.eigh(model.M_r, B)
+    phi = phi[:, ::-1]
+    mass = np.einsum("ij,ij->j", phi, model.M_r @ phi)
+    phi = phi / np.sqrt(mass)
     full = model.expand(phi)
+    lam = 2.0 * strain_energy(model, full)
+    lam = np.where(lam < 1e-10 * s, 0.0, lam)
+    order = np.argsort(lam, kind="stable")
+    lam, full = lam[order], full[:, order]
+    if n_modes is not None:
+        lam, full = lam[:n_modes], full[:, :n_modes]
     w = full[0::2]
     for j in range(full.shape[1]):
         i = int(np.argmax(np.abs(w[:, j])))
@@ -464,14 +516,15 @@ def fe_transient(
     dt, t_end : time step and end time; output on ``t = k dt``, k = 0..round(t_end/dt).
     output_x : output positions (default: contactor positions, then L).
     n_elements : about this many elements; nodes are placed at contactors,
-        springs, output points and the point-force position.
+        springs and the point-force position (output points need not be
+        nodes: outputs use the Hermite interpolation).
 
     Method
     ------
     Incremental Newmark: ``K_eff du = f_{n+1} - K_s u_n + M(4/h v_n + a_n) + C_s v_n``
     with ``K_eff = K_s + 2/h C_s + 4/h^2 M``, Cholesky-factorised and cached
     per (state, dt).  If a contactor's g changes sign over a step, the step
-    length tau with g(tau) = 0 is found by Brent's method (xtol 1e-13 s; each
+    length tau with g(tau) = 0 is found by Brent's method (xtol 1e-14 s; each
     trial is a full Newmark step of length tau, factorised afresh), the step is
     taken to tau, the state switched, the acceleration re-computed from
     equilibrium in the new state (damping changes), and the remainder of the
@@ -491,7 +544,7 @@ def fe_transient(
     kind = load.get("kind", "none")
     if output_x is None:
         output_x = [c["position"] for c in contactors] + [length]
-    extra_nodes = [c["position"] for c in contactors] + list(output_x)
+    extra_nodes = [c["position"] for c in contactors]
     if kind == "point_force":
         extra_nodes.append(load["position"])
     model = assemble(
@@ -536,9 +589,6 @@ def fe_transient(
     else:
         raise ValueError(f"unknown load kind {kind!r}")
 
-    def f_ext(t: float) -> np.ndarray:
-        return amp(t) * fvec
-
     # states ---------------------------------------------------------------
     state_cache: dict[tuple, tuple] = {}
     factor_cache: dict[tuple, tuple] = {}
@@ -565,36 +615,39 @@ def fe_transient(
         return state_cache[key]
 
     def factor(key: tuple, h: float, cache: bool) -> tuple:
+        """(Cholesky factor of K_eff(h), B = 4/h M + C) for the state."""
         fk = (key, h)
         if cache and fk in factor_cache:
             return factor_cache[fk]
         Ks, _, C = state(key)
         n_fact[0] += 1
-        fac = sla.cho_factor(Ks + (2.0 / h) * C + (4.0 / (h * h)) * Mr, check_finite=False)
+        c, _lower = sla.cho_factor(Ks + (2.0 / h) * C + (4.0 / (h * h)) * Mr, lower=False, check_finite=False)
+        out = (c, (4.0 / h) * Mr + C)
         if cache:
-            factor_cache[fk] = fac
-        return fac
+            factor_cache[fk] = out
+        return out
+
+    Mchol, _ = sla.cho_factor(Mr, lower=False, check_finite=False)
 
     def accel(key: tuple, u: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        """Acceleration from equilibrium M a = f - C v - K u (+ contact force)."""
         Ks, fc, C = state(key)
-        return Mfac_solve(f_ext(t) + fc - Ks @ u - C @ v)
-
-    Mfac = sla.cho_factor(Mr, check_finite=False)
-
-    def Mfac_solve(b: np.ndarray) -> np.ndarray:
-        return sla.cho_solve(Mfac, b, check_finite=False)
+        x, info = potrs(Mchol, amp(t) * fvec + fc - Ks @ u - C @ v, lower=0)
+        return x
 
     def newmark(key, u0, v0, a0, t0, h, fac):
+        """One average-acceleration step of length h in state ``key``."""
         Ks, fc, C = state(key)
-        rhs = f_ext(t0 + h) + fc - Ks @ u0 + Mr @ ((4.0 / h) * v0 + a0) + C @ v0
-        du = sla.cho_solve(fac, rhs, check_finite=False)
+        c, B = fac
+        rhs = amp(t0 + h) * fvec + fc - Ks @ u0 + B @ v0 + Mr @ a0
+        du, info = potrs(c, rhs, lower=0)
         u1 = u0 + du
         v1 = (2.0 / h) * du - v0
         a1 = (4.0 / (h * h)) * du - (4.0 / h) * v0 - a0
         return u1, v1, a1, du
 
-    def gaps(u: np.ndarray) -> np.ndarray:
-        return cgap - cs * u[cdof] if nc else np.zeros(0)
+    def gap(u: np.ndarray, i: int) -> float:
+        return float(cgap[i] - cs[i] * u[cdof[i]])
 
     # initial state --------------------------------------------------------
     u = np.zeros(nf)
@@ -602,24 +655,27 @@ def fe_transient(
     if initial:
         if "tip_displacement" in initial:
             p = np.zeros(nf)
-            p[model.reduced_index(2 * (model.n_nodes - 1))] = 1.0
+            itip = model.reduced_index(2 * (model.n_nodes - 1))
+            p[itip] = 1.0
             us = sla.solve(Kr, p, assume_a="pos")
-            u = us * (float(initial["tip_displacement"]) / us[model.reduced_index(2 * (model.n_nodes - 1))])
+            u = us * (float(initial["tip_displacement"]) / us[itip])
         else:
             unknown = set(initial) - {"w", "w_x", "w_t", "w_xt"}
             if unknown:
                 raise ValueError(f"unknown initial keys {sorted(unknown)}")
             u = model.nodal_vector(initial.get("w"), initial.get("w_x"))[free]
             v = model.nodal_vector(initial.get("w_t"), initial.get("w_xt"))[free]
-    key = tuple(bool(g < 0) for g in gaps(u))
-    t0 = 0.0
-    a = accel(key, u, v, t0)
+    key = tuple(gap(u, i) < 0 for i in range(nc))
+    a = accel(key, u, v, 0.0)
 
     # outputs ----------------------------------------------------------------
     n_steps = int(round(t_end / dt))
+    nt = n_steps + 1
     x_out = np.asarray(output_x, dtype=float)
     P = model.interpolation_matrix(x_out)[:, free]
-    nt = n_steps + 1
+    block = 4096
+    Ubuf = np.empty((block, nf))
+    Vbuf = np.empty((block, nf))
     W = np.empty((nt, len(x_out)))
     V = np.empty((nt, len(x_out)))
     KE = np.empty(nt)
@@ -633,27 +689,40 @@ def fe_transient(
     event_gap: list = []
     work = 0.0
     diss = 0.0
+    cdof_arr = np.asarray(cdof, dtype=int)
 
-    def record(k: int) -> None:
-        W[k] = P @ u
-        V[k] = P @ v
-        KE[k] = 0.5 * v @ (Mr @ v)
-        SE[k] = 0.5 * u @ (Kr @ u)
-        g = gaps(u)
-        on = np.array(key, dtype=bool)
-        CE[k] = 0.5 * float(np.sum(ck[on] * g[on] ** 2))
-        FC[k] = np.where(on, cs * ck * g, 0.0)
-        ENG[k] = on
+    def flush(k0: int, k1: int) -> None:
+        """Outputs and energies of grid points k0..k1-1 from the buffers."""
+        U = Ubuf[: k1 - k0]
+        Vv = Vbuf[: k1 - k0]
+        W[k0:k1] = U @ P.T
+        V[k0:k1] = Vv @ P.T
+        KE[k0:k1] = 0.5 * np.einsum("ij,ij->i", Vv, Vv @ Mr)
+        full = np.zeros((model.n_dof, k1 - k0))
+        full[free] = U.T
+        SE[k0:k1] = strain_energy(model, full)
+        g = cgap[None, :] - cs[None, :] * U[:, cdof_arr]
+        on = ENG[k0:k1]
+        CE[k0:k1] = 0.5 * np.sum(np.where(on, ck * g * g, 0.0), axis=1)
+        FC[k0:k1] = np.where(on, cs * ck * g, 0.0)
+
+    def store(k: int) -> None:
+        j = k % block
+        Ubuf[j] = u
+        Vbuf[j] = v
+        ENG[k] = key
         WORK[k] = work
         DISS[k] = diss
+        if j == block - 1 or k == nt - 1:
+            flush(k - j, k + 1)
 
-    def account(du, t_a, t_b, key_, h):
+    def account(du: np.ndarray, t_a: float, t_b: float, C: np.ndarray, h: float) -> None:
         nonlocal work, diss
-        _, _, C = state(key_)
-        work += 0.5 * du @ (f_ext(t_a) + f_ext(t_b))
-        diss += du @ (C @ du) / h
+        work += 0.5 * (amp(t_a) + amp(t_b)) * float(du @ fvec)
+        if xi_free != 0.0 or xi_contact != 0.0:
+            diss += float(du @ (C @ du)) / h
 
-    record(0)
+    store(0)
     tiny = 1e-13  # s: below this a remaining sub-step is dropped / a root is "at the start"
     for n in range(n_steps):
         t_grid_end = (n + 1) * dt
@@ -661,68 +730,59 @@ def fe_transient(
         rem = dt
         toggled_at_t: set[int] = set()
         guard = 0
-        while rem > tiny:
+        while True:
             guard += 1
             if guard > 1000:
                 raise RuntimeError(f"too many switches in step {n}")
-            full_step = rem == dt
-            fac = factor(key, rem, cache=full_step)
+            fac = factor(key, rem, cache=(rem == dt))
             u1, v1, a1, du = newmark(key, u, v, a, t, rem, fac)
-            g0 = gaps(u)
-            g1 = gaps(u1)
-            bad = []
+            taus: dict[int, float] = {}
             for i in range(nc):
-                if (not key[i] and g1[i] < 0) or (key[i] and g1[i] > 0):
-                    bad.append(i)
-            taus = {}
-            for i in bad:
+                g1 = gap(u1, i)
+                if not ((not key[i] and g1 < 0) or (key[i] and g1 > 0)):
+                    continue
+                g0 = gap(u, i)
                 # consistent side at the start?  free: g0 > 0; engaged: g0 < 0
-                start_ok = (g0[i] > 0) if not key[i] else (g0[i] < 0)
-                if not start_ok:
+                if not ((g0 > 0) if not key[i] else (g0 < 0)):
                     tau = 0.0
                 else:
-                    def gfun(h, i=i):
+                    def gfun(h, i=i, g0=g0):
                         if h <= 0.0:
-                            return g0[i]
-                        uh, _, _, _ = newmark(key, u, v, a, t, h, factor(key, h, cache=False))
-                        return cgap[i] - cs[i] * uh[cdof[i]]
+                            return g0
+                        uh = newmark(key, u, v, a, t, h, factor(key, h, cache=False))[0]
+                        return gap(uh, i)
                     tau = brentq(gfun, 0.0, rem, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
                 if tau <= tiny and i in toggled_at_t:
                     continue  # grazing chatter guard: no second zero-length toggle
                 taus[i] = tau
             if not taus:
-                account(du, t, t + rem, key, rem)
+                account(du, t, t + rem, state(key)[2], rem)
                 u, v, a = u1, v1, a1
-                t = t_grid_end
-                rem = 0.0
                 break
             tau = min(taus.values())
             switch = sorted(i for i, ti in taus.items() if ti <= tau + 1e-13)
             if tau > tiny:
-                fac = factor(key, tau, cache=False)
-                u1, v1, a1, du = newmark(key, u, v, a, t, tau, fac)
-                account(du, t, t + tau, key, tau)
+                u1, v1, a1, du = newmark(key, u, v, a, t, tau, factor(key, tau, cache=False))
+                account(du, t, t + tau, state(key)[2], tau)
                 u, v = u1, v1
                 t = t + tau
-                rem = t_grid_end - t
                 toggled_at_t = set()
-            gnow = gaps(u)
             newkey = list(key)
             for i in switch:
+                gnow = gap(u, i)
                 newkey[i] = not key[i]
                 events.append((t, "impact" if newkey[i] else "rebound", i))
-                event_gap.append(float(gnow[i]))
+                event_gap.append(gnow)
                 toggled_at_t.add(i)
-            # contact energy 1/2 k g^2 is switched on/off at g ~ 0: add the
-            # (round-off level) jump to the work so the balance stays exact
-            for i in switch:
-                dE = 0.5 * ck[i] * gnow[i] ** 2
-                work += dE if newkey[i] else -dE
+                # the contactor energy 1/2 k g^2 (g ~ 1e-16) appears/vanishes:
+                # book the round-off-level jump as work so the balance is exact
+                work += (0.5 if newkey[i] else -0.5) * ck[i] * gnow * gnow
             key = tuple(newkey)
             a = accel(key, u, v, t)
-        if rem <= tiny and rem != 0.0:
-            t = t_grid_end
-        record(n + 1)
+            rem = t_grid_end - t
+            if rem <= tiny:
+                break
+        store(n + 1)
 
     return TransientResult(
         t=np.arange(nt) * dt,

@@ -194,3 +194,88 @@ class InitialCondition:
             and not any(self.modal_displacement or ())
             and not any(self.modal_velocity or ())
         )
+
+
+@dataclass(frozen=True)
+class TimePiece:
+    """One piece of a time history: ``u(t) = const + slope (t - t0) + amp sin(Omega (t - t0) + phase)``."""
+
+    t0: float
+    t1: float
+    const: float = 0.0
+    slope: float = 0.0
+    amp: float = 0.0
+    Omega: float = 0.0
+    phase: float = 0.0
+
+    def value(self, t: float) -> float:
+        tau = t - self.t0
+        return self.const + self.slope * tau + self.amp * math.sin(self.Omega * tau + self.phase)
+
+
+def time_pieces(excitation: Excitation, end_time: float) -> list[TimePiece]:
+    """Cut the history of ``excitation`` on [0, end_time] into pieces of one closed form each.
+
+    The solver integrates each piece exactly: the half-sine as a sinusoid, a
+    table held constant (paper, rectangular steps before eq. 10) or linear
+    (first-order hold) between samples.
+    """
+    T = float(end_time)
+    s = excitation.scale
+    if not excitation.active:
+        return [TimePiece(0.0, T)]
+    start = excitation.start
+    raw: list[TimePiece] = []
+    if excitation.shape == "half_sine":
+        assert excitation.duration is not None
+        Om = math.pi / excitation.duration
+        raw.append(TimePiece(0.0, start))
+        raw.append(TimePiece(start, start + excitation.duration, amp=s * excitation.amplitude, Omega=Om))
+        raw.append(TimePiece(start + excitation.duration, math.inf))
+    elif excitation.shape == "step":
+        raw.append(TimePiece(0.0, start))
+        raw.append(TimePiece(start, math.inf, const=s * excitation.amplitude))
+    else:
+        assert excitation.times is not None and excitation.values is not None
+        tk = excitation.times + start
+        vk = s * excitation.values
+        raw.append(TimePiece(0.0, float(tk[0])))
+        for i in range(tk.size - 1):
+            t0, t1 = float(tk[i]), float(tk[i + 1])
+            if excitation.hold == "linear":
+                slope = (vk[i + 1] - vk[i]) / (t1 - t0)
+                raw.append(TimePiece(t0, t1, const=float(vk[i]), slope=float(slope)))
+            else:
+                raw.append(TimePiece(t0, t1, const=float(vk[i])))
+        raw.append(TimePiece(float(tk[-1]), math.inf))
+    out = []
+    for p in raw:
+        t0, t1 = max(p.t0, 0.0), min(p.t1, T)
+        if t1 <= t0:
+            continue
+        if t0 > p.t0:  # shift the piece's origin to t0
+            tau = t0 - p.t0
+            p = TimePiece(p.t0, p.t1, p.const + p.slope * tau, p.slope, p.amp, p.Omega, p.phase + p.Omega * tau)
+        out.append(TimePiece(t0, t1, p.const, p.slope, p.amp, p.Omega, p.phase))
+    return out
+
+
+def spatial_projection(excitation: Excitation, shapes_at, integral: np.ndarray, rho_a: float) -> np.ndarray:
+    """Modal weights ``p_n`` with ``<f(., t), W_n> = p_n u(t)`` (paper eq. 8).
+
+    Parameters
+    ----------
+    shapes_at : callable
+        ``shapes_at(x) -> (n, p)`` mode shapes of the state.
+    integral : ndarray, (n,)
+        ``int W_n dx`` of the state.
+    rho_a : float
+        Mass per length; base acceleration is the load ``-rho A ug''(t)``.
+    """
+    if excitation.kind == "base_acceleration":
+        return -rho_a * integral
+    if excitation.kind == "distributed_force":
+        return integral.copy()
+    if excitation.kind == "point_force":
+        return shapes_at([excitation.position])[:, 0]
+    return np.zeros_like(integral)

@@ -59,6 +59,7 @@ if TYPE_CHECKING:
 
 __all__ = ["ModeSet", "ScenarioModes", "mode_set", "scenario_modes", "modes", "count_below"]
 
+_MERGE_DISTANCE = 3e-5  # fraction of L
 _GAUSS_ORDER = 20
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(_GAUSS_ORDER)
 
@@ -90,7 +91,9 @@ class _Layout:
 
 def _merge_springs(beam: Beam, springs: Iterable[tuple[float, float]]) -> _Layout:
     L = beam.length
-    tol = 1e-12 * L
+    # springs closer than this to an end or to each other are merged: a shorter
+    # segment makes the exact dynamic stiffness too ill-conditioned to count roots
+    tol = _MERGE_DISTANCE * L
     k_left, k_right = beam.left.translational, beam.right.translational
     interior: dict[float, float] = {}
     for x, k in springs:
@@ -261,7 +264,10 @@ def _segment_stiffness(beta: float, length: float) -> np.ndarray:
     B1 = _basis_row(zl, zl, kry)
     D = np.array([B0[0], B0[1], B1[0], B1[1]])
     F = np.array([B0[3], -B0[2], -B1[3], B1[2]])
-    K = np.linalg.solve(D.T, F.T).T  # F D^{-1}
+    try:
+        K = np.linalg.solve(D.T, F.T).T  # F D^{-1}
+    except np.linalg.LinAlgError:  # exactly at a clamped-clamped root of the segment
+        return _segment_stiffness(beta * (1.0 + 1e-12), length)
     return 0.5 * (K + K.T)
 
 
@@ -319,7 +325,7 @@ def _rigid_modes(lay: _Layout) -> np.ndarray:
         scale = np.array([1.0, lay.nodes[-1]])
         _, sv, vt = np.linalg.svd(C * scale)
         rank = int(np.sum(sv > 1e-10 * sv[0]))
-        null = (vt[rank:] / scale).T  # (2, r)
+        null = (vt[rank:] * scale).T  # (2, r)
     else:
         null = np.eye(2)
     L = lay.nodes[-1]
@@ -349,7 +355,7 @@ def _bracket_roots(lay: _Layout, n_needed: int, j0: int) -> list[tuple[float, fl
         return []
     target = j0 + n_needed
     L = lay.nodes[-1]
-    hi = (n_needed + 1.5) * math.pi / L
+    hi = (n_needed + 1.5) * math.pi / L * 1.0137  # off any root of a classical beam
     jhi = _count(lay, hi)
     guard = 0
     while jhi < target:
@@ -390,11 +396,18 @@ def _refine(lay: _Layout, lo: float, hi: float, index: int) -> float:
         else:
             lo = mid
     kry = _krylov_mask(lay, hi)
-    flo, fhi = _det(lay, lo, kry), _det(lay, hi, kry)
-    if flo * fhi < 0.0:
-        return float(
-            brentq(lambda b: _det(lay, b, kry), lo, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=200)
-        )
+    # the determinant changes sign at the isolated root; an end point lying
+    # within round-off of a neighbouring root can hide that, so sample inside
+    grid = np.linspace(lo, hi, 17)
+    vals = np.array([_det(lay, b, kry) for b in grid])
+    for i in range(16):
+        if vals[i] * vals[i + 1] < 0.0:
+            return float(
+                brentq(
+                    lambda b: _det(lay, b, kry), grid[i], grid[i + 1], xtol=1e-300,
+                    rtol=4 * np.finfo(float).eps, maxiter=200,
+                )
+            )
     # no sign change (repeated root or determinant underflow): bisect the exact count
     for _ in range(200):
         mid = 0.5 * (lo + hi)
@@ -576,15 +589,41 @@ def _build(lay: _Layout, beam: Beam, springs: tuple[tuple[float, float], ...], c
     s = lay.n_segments
     coef = np.zeros((count, s, 4))
     kry = np.zeros((count, s), dtype=bool)
-    for i, b in enumerate(betas):
-        kry[r + i] = _krylov_mask(lay, b)
-        coef[r + i] = _null_vector(lay, b, kry[r + i]).reshape(s, 4)
+    i = 0
+    while i < betas.size:
+        j = i + 1
+        while j < betas.size and betas[j] - betas[j - 1] <= 1e-7 * betas[j]:
+            j += 1
+        b_mid = float(np.mean(betas[i:j]))
+        mask = _krylov_mask(lay, b_mid)
+        if j - i == 1:
+            coef[r + i] = _null_vector(lay, betas[i], mask).reshape(s, 4)
+        else:  # (nearly) repeated root: the null space of the cluster
+            _, _, vt = np.linalg.svd(_characteristic(lay, b_mid, mask))
+            for m in range(j - i):
+                coef[r + i + m] = vt[-(m + 1)].reshape(s, 4)
+                betas[i + m] = betas[i + m]
+        kry[r + i : r + j] = mask
+        i = j
     beta_all = np.concatenate([np.zeros(r), betas])
     c2 = math.sqrt(lay.EI / lay.rhoA)
     ms = ModeSet(beam, springs, beta_all**2 * c2, beta_all, r, lay, coef, rigid[:r], kry)
     # normalise elastic shapes: rho A int W^2 = 1, largest displacement positive
     if count > r:
         x, w = _quadrature(lay.nodes, float(betas.max()))
+        # mass-orthonormalise within clusters of repeated roots (Gram-Schmidt)
+        i = 0
+        while i < betas.size:
+            j = i + 1
+            while j < betas.size and betas[j] - betas[j - 1] <= 1e-7 * betas[j]:
+                j += 1
+            if j - i > 1:
+                Wc = ms.shapes(x)[r + i : r + j]
+                G = lay.rhoA * (Wc * w) @ Wc.T
+                Lc = np.linalg.cholesky(G)
+                T = np.linalg.inv(Lc)
+                coef[r + i : r + j] = np.einsum("ab,bsk->ask", T, coef[r + i : r + j])
+            i = j
         W = ms.shapes(x)[r:]
         norms = np.sqrt(lay.rhoA * (W**2) @ w)
         idx = np.argmax(np.abs(W), axis=1)

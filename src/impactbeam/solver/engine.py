@@ -1,0 +1,413 @@
+"""Event-driven exact integration of the piecewise-linear modal model (paper section 2).
+
+Between events the state (set of engaged contactors) and the load form are
+fixed and every mode has a closed-form response
+(:mod:`~impactbeam.solver.closed_form`). The integrator walks from event to
+event: it evaluates the closed form on the sampling grid (which also yields
+the output), detects a crossing of a contactor's opening
+``g = gap - s w(a)`` between two grid points (or a grazing dip below zero
+between them, found from the exact derivative), locates it with Brent's
+method on the closed form, switches the state there and projects the modal
+displacement and velocity onto the new modes (paper eqs. 11-12).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..beam import Beam, Contactor
+from ..loading import Excitation, InitialCondition, TimePiece, time_pieces
+from ..modes import mode_set
+from .closed_form import ClosedFormSegment, LoadForm
+from .options import Damping, SolverOptions
+from .states import StateModel, StateSpace
+
+__all__ = ["Event", "Segment", "RawSolution", "integrate"]
+
+_CHUNK = 2048
+
+
+@dataclass(frozen=True)
+class Event:
+    """An impact (contactor engages) or rebound (it releases) at an exact time."""
+
+    time: float
+    kind: str  # "impact" | "rebound"
+    contactor: int
+    velocity: float  # w_t at the contactor [m/s]
+
+
+@dataclass(frozen=True, eq=False)
+class Segment:
+    """Closed-form modal response on ``[t0, t1]`` in one state (dense output)."""
+
+    t0: float
+    t1: float
+    engaged: tuple[int, ...]
+    solution: ClosedFormSegment
+    piece: TimePiece
+
+
+@dataclass(eq=False)
+class RawSolution:
+    """What :func:`integrate` returns; :class:`~impactbeam.result.SimulationResult` wraps it."""
+
+    time: np.ndarray
+    w: np.ndarray  # (time, point)
+    w_t: np.ndarray
+    w_contact: np.ndarray  # (time, contactor)
+    w_t_contact: np.ndarray
+    state_code: np.ndarray  # (time,) index into state_keys
+    state_keys: list[tuple[int, ...]]
+    kinetic: np.ndarray
+    modal_strain: np.ndarray  # 1/2 sum omega^2 eta^2 (includes engaged springs at zero gap)
+    load_power: np.ndarray  # u(t) sum p_n eta'_n
+    damping_power: np.ndarray  # sum 2 xi omega eta'^2
+    eta: np.ndarray  # (time, mode) in the basis of the state at that time
+    eta_t: np.ndarray
+    events: list[Event]
+    segments: list[Segment]
+    space: StateSpace
+    status: int
+    message: str
+    switch_energy_jumps: list[float]
+
+
+def initial_coordinates(
+    beam: Beam, initial: InitialCondition, n_modes: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Free-state modal displacement and velocity at t = 0."""
+    ms = mode_set(beam, (), n_modes)
+    eta = np.zeros(ms.count)
+    deta = np.zeros(ms.count)
+    if initial.tip_displacement:
+        x0 = beam.length if initial.position is None else initial.position
+        # flexibility at x0 from a converged modal sum (terms fall as n^-4)
+        big = mode_set(beam, (), max(120, n_modes))
+        flex = float(np.sum(big.static_coordinates(x0) * big.shapes([x0])[:, 0]))
+        eta = ms.static_coordinates(x0, initial.tip_displacement / flex)
+    if initial.modal_displacement is not None:
+        v = np.asarray(initial.modal_displacement)
+        eta[: min(v.size, eta.size)] += v[: eta.size]
+    if initial.modal_velocity is not None:
+        v = np.asarray(initial.modal_velocity)
+        deta[: min(v.size, deta.size)] += v[: deta.size]
+    return eta, deta
+
+
+def _segment(st: StateModel, piece: TimePiece, t: float, eta: np.ndarray, deta: np.ndarray) -> ClosedFormSegment:
+    tau = t - piece.t0
+    p = st.load_weights
+    a = p * (piece.const + piece.slope * tau) + st.gap_force
+    b = p * piece.slope if piece.slope else None
+    d = p * piece.amp if piece.amp else None
+    return ClosedFormSegment(st.dyn, LoadForm(a, b, d, piece.Omega, piece.phase + piece.Omega * tau), eta, deta)
+
+
+class _Integrator:
+    def __init__(
+        self,
+        beam: Beam,
+        contactors: tuple[Contactor, ...],
+        damping: Damping,
+        excitation: Excitation,
+        initial: InitialCondition,
+        options: SolverOptions,
+        points: np.ndarray,
+        progress: Callable[[float], None] | None,
+    ) -> None:
+        self.opt = options
+        self.contactors = contactors
+        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, points)
+        self.pieces = time_pieces(excitation, options.end_time)
+        self.gap = np.array([c.gap for c in contactors])
+        self.side = np.array([c.direction for c in contactors])
+        self.tol_h = 1e-12 * beam.length
+        self.progress = progress
+        dt = options.time_step
+        # scan step: at most 1/8 of the shortest period of any state (the all-engaged one is stiffest)
+        all_eng = tuple(range(len(contactors)))
+        wmax = max(self.space.state(()).omega_max, self.space.state(all_eng).omega_max if contactors else 0.0)
+        self.sub = max(1, math.ceil(dt * wmax / (2.0 * math.pi) * 8.0)) if wmax > 0 else 1
+        self.h = dt / self.sub
+        self.n_out = int(math.floor(options.end_time / dt * (1.0 + 1e-12))) + 1
+        self.time = np.arange(self.n_out) * dt
+        n_p = points.size
+        n_c = len(contactors)
+        nm = options.modes
+        self.w = np.full((self.n_out, n_p), np.nan)
+        self.w_t = np.full((self.n_out, n_p), np.nan)
+        self.wc = np.full((self.n_out, n_c), np.nan)
+        self.wtc = np.full((self.n_out, n_c), np.nan)
+        self.code = np.full(self.n_out, -1, dtype=np.int16)
+        self.kin = np.full(self.n_out, np.nan)
+        self.strain = np.full(self.n_out, np.nan)
+        self.lpow = np.full(self.n_out, np.nan)
+        self.dpow = np.full(self.n_out, np.nan)
+        self.eta = np.full((self.n_out, nm), np.nan)
+        self.eta_t = np.full((self.n_out, nm), np.nan)
+        self.keys: list[tuple[int, ...]] = []
+        self.events: list[Event] = []
+        self.segments: list[Segment] = []
+        self.jumps: list[float] = []
+
+    # ------------------------------------------------------------------ helpers
+    def _code(self, engaged: tuple[int, ...]) -> int:
+        if engaged not in self.keys:
+            self.keys.append(engaged)
+        return self.keys.index(engaged)
+
+    def _orient(self, engaged: tuple[int, ...]) -> np.ndarray:
+        o = np.ones(len(self.contactors))
+        o[list(engaged)] = -1.0
+        return o
+
+    def _h(self, st: StateModel, orient: np.ndarray, eta: np.ndarray, deta: np.ndarray):
+        wc = st.W_contact @ eta
+        dwc = st.W_contact @ deta
+        g = self.gap[:, None] - self.side[:, None] * wc
+        dg = -self.side[:, None] * dwc
+        return orient[:, None] * g, orient[:, None] * dg, wc, dwc
+
+    def _energy(self, st: StateModel, eta: np.ndarray, deta: np.ndarray) -> float:
+        """Total mechanical energy (beam + supports + engaged contactors) of one modal state."""
+        wc = st.W_contact @ eta
+        E = 0.5 * float(deta @ deta) + 0.5 * float(np.sum(st.modes.omega**2 * eta**2))
+        for i in st.engaged:
+            c = self.contactors[i]
+            g = c.gap - c.direction * wc[i]
+            E += 0.5 * c.stiffness * (g**2 - wc[i] ** 2)
+        return E
+
+    def _desired_switch(self, st, seg: ClosedFormSegment, orient, tau1: float, just: int | None) -> int | None:
+        """Contactor whose state is inconsistent at the start of a segment, if any.
+
+        For the contactor ``just`` switched at this instant only the direction of
+        motion is judged: the projection onto the new truncated mode set (eq. 12)
+        moves ``w(a)`` slightly, so its opening may start a hair on the wrong side.
+        """
+        if not self.contactors:
+            return None
+        e0, d0 = seg.evaluate(np.array([0.0, tau1]))
+        h, dh, _, _ = self._h(st, orient, e0, d0)
+        for c in range(len(self.contactors)):
+            if c == just:
+                if dh[c, 0] * tau1 < -self.tol_h:
+                    return c
+                continue
+            if h[c, 0] < -self.tol_h:
+                return c  # already on the wrong side (e.g. released inside the contactor)
+            if abs(h[c, 0]) <= self.tol_h:
+                if dh[c, 0] * tau1 < -self.tol_h:
+                    return c
+                if abs(dh[c, 0]) * tau1 <= self.tol_h and h[c, 1] < -self.tol_h:
+                    return c
+        return None
+
+    # ------------------------------------------------------------------ event location
+    def _locate(self, st, seg, orient, c: int, lo: float, hi: float, hlo: float, dlo: float, dhi: float) -> float | None:
+        W = st.W_contact[c]
+        o, s, gap = orient[c], self.side[c], self.gap[c]
+
+        def h(t: float) -> float:
+            e, _ = seg.evaluate(np.array([t]))
+            return float(o * (gap - s * (W @ e[:, 0])))
+
+        def dh(t: float) -> float:
+            _, d = seg.evaluate(np.array([t]))
+            return float(-o * s * (W @ d[:, 0]))
+
+        tol = self.opt.event_tolerance
+        hh = h(hi)
+        if hlo <= self.tol_h:
+            # starting on the contact surface: move to the maximum of h first
+            if dlo > 0 and dh(hi) < 0:
+                lo = brentq(dh, lo, hi, xtol=tol)
+                hlo = h(lo)
+            if hlo <= 0:
+                return None
+        if hh > 0:
+            # grazing: both ends open, the derivative changes sign
+            if not (dlo < 0 < dhi):
+                return None
+            tmin = brentq(dh, lo, hi, xtol=tol)
+            if h(tmin) > 0:
+                return None
+            hi = tmin
+            if h(hi) == 0:
+                return hi
+        return float(brentq(h, lo, hi, xtol=tol, rtol=4 * np.finfo(float).eps, maxiter=200))
+
+    # ------------------------------------------------------------------ main loop
+    def _run_from(self, eta: np.ndarray, deta: np.ndarray) -> RawSolution:
+        opt = self.opt
+        T = opt.end_time
+        engaged: tuple[int, ...] = ()
+        t = 0.0
+        k_piece = 0
+        status, message = 0, "The simulation reached end_time."
+        toggles_at_t: dict[int, int] = {}
+        last_t = -1.0
+        just: int | None = None
+        while t < T and k_piece < len(self.pieces):
+            piece = self.pieces[k_piece]
+            st = self.space.state(engaged)
+            orient = self._orient(engaged)
+            seg = _segment(st, piece, t, eta, deta)
+            t_end = min(piece.t1, T)
+            # consistency at the start of the segment (zero gap at rest, grazing, release)
+            c_bad = self._desired_switch(st, seg, orient, min(self.h, t_end - t) if t_end > t else self.h, just)
+            if c_bad is not None:
+                if t != last_t:
+                    toggles_at_t, last_t = {}, t
+                toggles_at_t[c_bad] = toggles_at_t.get(c_bad, 0) + 1
+                if toggles_at_t[c_bad] <= 2:
+                    engaged, eta, deta = self._switch(st, engaged, c_bad, t, eta, deta)
+                    just = c_bad
+                    if len(self.events) >= opt.max_events:
+                        status, message = 1, self._chatter_message(t)
+                        break
+                    continue
+            te, c_hit = self._advance(st, seg, orient, t, t_end)
+            self.segments.append(Segment(t, te, engaged, seg, piece))
+            e1, d1 = seg.evaluate(np.array([te - t]))
+            eta, deta = e1[:, 0], d1[:, 0]
+            t = te
+            if self.progress is not None:
+                self.progress(t)
+            just = c_hit
+            if c_hit is not None:
+                engaged, eta, deta = self._switch(st, engaged, c_hit, t, eta, deta)
+                if len(self.events) >= opt.max_events:
+                    status, message = 1, self._chatter_message(t)
+                    break
+            elif t >= piece.t1:
+                k_piece += 1
+        return RawSolution(
+            self.time, self.w, self.w_t, self.wc, self.wtc, self.code, self.keys, self.kin, self.strain,
+            self.lpow, self.dpow, self.eta, self.eta_t, self.events, self.segments, self.space, status,
+            message, self.jumps,
+        )
+
+    def _chatter_message(self, t: float) -> str:
+        return (
+            f"Stopped at t = {t:.9g} s after {len(self.events)} events (solver.max_events): "
+            "chattering contact; later samples are NaN."
+        )
+
+    def _switch(self, st, engaged, c, t, eta, deta):
+        new = tuple(sorted(set(engaged) ^ {c}))
+        kind = "impact" if c in new else "rebound"
+        E_before = self._energy(st, eta, deta)
+        vel = float(st.W_contact[c] @ deta)
+        if self.events and self.events[-1].time == t and self.events[-1].contactor == c:
+            self.events.pop()  # an impact and a rebound at one instant cancel (grazing touch)
+        else:
+            self.events.append(Event(t, kind, c, vel))
+        P = self.space.projection(new, engaged)
+        eta, deta = P @ eta, P @ deta
+        self.jumps.append(self._energy(self.space.state(new), eta, deta) - E_before)
+        return new, eta, deta
+
+    def _advance(self, st: StateModel, seg: ClosedFormSegment, orient, t0: float, t_end: float):
+        """Evaluate and store output on [t0, t_end); return (end time, contactor hit or None)."""
+        h = self.h
+        sub = self.sub
+        k = math.ceil(t0 / h - 1e-9)
+        if k * h < t0:
+            k += 1
+        k_last = math.floor(t_end / h + 1e-9)
+        e0, d0 = seg.evaluate(np.zeros(1))
+        hp, dhp, _, _ = self._h(st, orient, e0, d0)
+        hp, dhp = hp[:, 0], dhp[:, 0]
+        tau_prev = 0.0
+        code = self._code(st.engaged)
+        has_c = len(self.contactors) > 0
+        while True:
+            k_hi = min(k + _CHUNK, k_last + 1)
+            taus = np.arange(k, k_hi) * h - t0
+            append_end = k_hi > k_last and (t_end - t0) > (taus[-1] if taus.size else -1.0) + 1e-15
+            tau_eval = np.append(taus, t_end - t0) if append_end else taus
+            if tau_eval.size == 0:
+                return t_end, None
+            eta, deta = seg.evaluate(tau_eval)
+            hit_tau, hit_c = None, None
+            if has_c:
+                H, dH, _, _ = self._h(st, orient, eta, deta)
+                Hprev = np.concatenate([hp[:, None], H[:, :-1]], axis=1)
+                dHprev = np.concatenate([dhp[:, None], dH[:, :-1]], axis=1)
+                tprev = np.concatenate([[tau_prev], tau_eval[:-1]])
+                start_touch = np.abs(Hprev) <= self.tol_h
+                cross = (H <= 0.0) & ((Hprev > 0.0) | (start_touch & (dHprev > 0)))
+                dtau = tau_eval - tprev
+                graze = (Hprev > 0) & (H > 0) & (dHprev < 0) & (dH > 0)
+                graze &= (Hprev < np.abs(dHprev) * dtau) | (H < np.abs(dH) * dtau)
+                cand = cross | graze
+                if cand.any():
+                    cols = np.nonzero(cand.any(axis=0))[0]
+                    for j in cols:
+                        best = None
+                        for c in np.nonzero(cand[:, j])[0]:
+                            r = self._locate(st, seg, orient, int(c), tprev[j], tau_eval[j], Hprev[c, j], dHprev[c, j], dH[c, j])
+                            if r is not None and (best is None or r < best[0]):
+                                best = (r, int(c))
+                        if best is not None:
+                            hit_tau, hit_c = best
+                            break
+            n_keep = taus.size if hit_tau is None else int(np.searchsorted(taus, hit_tau, side="left"))
+            self._store(st, seg, code, k, taus[:n_keep], eta[:, :n_keep], deta[:, :n_keep])
+            if hit_tau is not None:
+                return t0 + hit_tau, hit_c
+            if k_hi > k_last:
+                return t_end, None
+            hp, dhp = (H[:, -1], dH[:, -1]) if has_c else (hp, dhp)
+            tau_prev = tau_eval[-1]
+            k = k_hi
+
+    def _store(self, st, seg, code, k0, taus, eta, deta) -> None:
+        if taus.size == 0:
+            return
+        ks = k0 + np.arange(taus.size)
+        sel = ks % self.sub == 0
+        if not sel.any():
+            return
+        idx = ks[sel] // self.sub
+        ok = idx < self.n_out
+        idx = idx[ok]
+        e = eta[:, sel][:, ok]
+        d = deta[:, sel][:, ok]
+        self.w[idx] = (st.W_out @ e).T
+        self.w_t[idx] = (st.W_out @ d).T
+        if self.contactors:
+            self.wc[idx] = (st.W_contact @ e).T
+            self.wtc[idx] = (st.W_contact @ d).T
+        self.code[idx] = code
+        self.kin[idx] = 0.5 * np.sum(d**2, axis=0)
+        self.strain[idx] = 0.5 * np.sum((st.modes.omega[:, None] * e) ** 2, axis=0)
+        f = seg.force(taus[sel][ok]) - st.gap_force[:, None]
+        self.lpow[idx] = np.sum(f * d, axis=0)
+        self.dpow[idx] = np.sum((2.0 * st.dyn.decay)[:, None] * d**2, axis=0)
+        n = e.shape[0]
+        self.eta[idx, :n] = e.T
+        self.eta_t[idx, :n] = d.T
+
+
+def integrate(
+    beam: Beam,
+    contactors: tuple[Contactor, ...],
+    damping: Damping,
+    excitation: Excitation,
+    initial: InitialCondition,
+    options: SolverOptions,
+    points: np.ndarray,
+    progress: Callable[[float], None] | None = None,
+) -> RawSolution:
+    """Run the event-driven exact integration; see :func:`impactbeam.simulate`."""
+    integ = _Integrator(beam, contactors, damping, excitation, initial, options, points, progress)
+    eta, deta = initial_coordinates(beam, initial, options.modes)
+    return integ._run_from(eta, deta)

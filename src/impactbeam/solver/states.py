@@ -1,0 +1,112 @@
+"""The linear states of the piecewise-linear system and the projections between them.
+
+A state is the set of engaged contactors (paper: free state T^f and contact
+state T^c). Each has its own modes, damping and constant gap forces; states
+are built on demand and cached, as are the projection matrices (paper eq. 12).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..beam import Beam, Contactor
+from ..loading import Excitation, spatial_projection
+from ..modes import ModeSet, mode_set
+from .closed_form import ModalDynamics
+from .options import Damping
+
+__all__ = ["StateModel", "StateSpace"]
+
+
+@dataclass(frozen=True, eq=False)
+class StateModel:
+    """Everything the integrator needs about one state.
+
+    Attributes
+    ----------
+    engaged : tuple of int
+        Indices of the engaged contactors.
+    modes : ModeSet
+    dyn : ModalDynamics
+    W_contact : ndarray, (n_contactors, n)
+        ``W_n(a_c)`` for every contactor (engaged or not).
+    W_out : ndarray, (n_points, n)
+        Mode shapes at the output points.
+    load_weights : ndarray, (n,)
+        ``p_n`` with modal load ``p_n u(t)`` (paper eq. 8).
+    gap_force : ndarray, (n,)
+        Modal weights of the constant forces ``s k c`` of engaged gapped contactors.
+    """
+
+    engaged: tuple[int, ...]
+    modes: ModeSet
+    dyn: ModalDynamics
+    W_contact: np.ndarray
+    W_out: np.ndarray
+    load_weights: np.ndarray
+    gap_force: np.ndarray
+
+    @property
+    def omega_max(self) -> float:
+        return float(self.modes.omega.max())
+
+
+class StateSpace:
+    """Builds and caches the states of one problem and the projections between them."""
+
+    def __init__(
+        self,
+        beam: Beam,
+        contactors: Sequence[Contactor],
+        damping: Damping,
+        excitation: Excitation,
+        n_modes: int,
+        points: np.ndarray,
+    ) -> None:
+        self.beam = beam
+        self.contactors = tuple(contactors)
+        self.damping = damping
+        self.excitation = excitation
+        self.n_modes = n_modes
+        self.points = np.asarray(points, dtype=float)
+        self._states: dict[tuple[int, ...], StateModel] = {}
+        self._proj: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
+        self.positions = np.array([c.position for c in self.contactors], dtype=float)
+
+    def state(self, engaged: tuple[int, ...]) -> StateModel:
+        st = self._states.get(engaged)
+        if st is None:
+            st = self._build(engaged)
+            self._states[engaged] = st
+        return st
+
+    def _build(self, engaged: tuple[int, ...]) -> StateModel:
+        springs = [(self.contactors[i].position, self.contactors[i].stiffness) for i in engaged]
+        ms = mode_set(self.beam, springs, self.n_modes)
+        xi = self.damping.ratios(bool(engaged), ms.count)
+        dyn = ModalDynamics(ms.omega, xi)
+        n = ms.count
+        Wc = ms.shapes(self.positions).T if self.contactors else np.zeros((0, n))
+        Wo = ms.shapes(self.points).T if self.points.size else np.zeros((0, n))
+        p = spatial_projection(self.excitation, ms.shapes, ms.integral(), self.beam.mass_per_length)
+        gap_force = np.zeros(n)
+        for i in engaged:
+            c = self.contactors[i]
+            gap_force += c.direction * c.stiffness * c.gap * Wc[i]
+        return StateModel(engaged, ms, dyn, Wc, Wo, p, gap_force)
+
+    def projection(self, to: tuple[int, ...], frm: tuple[int, ...]) -> np.ndarray:
+        """``P[n, p] = rho A int W_n^to W_p^from dx`` (paper eq. 12)."""
+        key = (to, frm)
+        P = self._proj.get(key)
+        if P is None:
+            P = self.state(to).modes.overlap(self.state(frm).modes)
+            self._proj[key] = P
+        return P
+
+    @property
+    def states(self) -> dict[tuple[int, ...], StateModel]:
+        return self._states
