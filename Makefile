@@ -20,7 +20,7 @@ demo: $(STAMP)
 	$(BIN)/impactbeam modes examples/specimen.toml
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_solver.py
