@@ -23,11 +23,20 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
 from typing import Any
 
 from .exceptions import ScenarioError
 
-__all__ = ["DIMENSIONS", "STANDARD_GRAVITY", "to_si", "unit_scale", "describe_dimension", "registry"]
+__all__ = [
+    "DIMENSIONS",
+    "STANDARD_GRAVITY",
+    "to_si",
+    "unit_scale",
+    "scale_decimal",
+    "describe_dimension",
+    "registry",
+]
 
 #: Standard gravity [m/s^2] (the "g" of accelerations).
 STANDARD_GRAVITY = 9.80665
@@ -84,6 +93,10 @@ _KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
 
 _UREG: Any = None
 _NUMBER_START = re.compile(r"^\s*[-+]?(\d|\.\d)")
+_NUMBER_UNIT = re.compile(
+    r"^\s*(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?i:inf(?:inity)?|nan))"
+    r"\s*(?P<unit>[^\s*/^].*?)\s*$"
+)
 _GRAVITY_G = re.compile(r"(?<![\w.])g(?![\w.])")
 
 
@@ -95,6 +108,19 @@ def registry() -> Any:
 
         _UREG = pint.UnitRegistry()
     return _UREG
+
+
+def scale_decimal(number: str, factor: float) -> float:
+    """``float(number) * factor``, rounded once: ``scale_decimal("3.03", 1e-3) == 3.03e-3``.
+
+    The product is formed in decimal arithmetic from the written number and
+    the shortest repr of ``factor``, so ``"3.03 mm"`` gives exactly the float
+    ``3.03e-3`` (a binary product would be one ulp off).
+    """
+    try:
+        return float(Decimal(number.strip()) * Decimal(repr(factor)))
+    except (InvalidOperation, ValueError):
+        return float(number) * factor
 
 
 class _UnitProblem(Exception):
@@ -136,8 +162,11 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
     return float(quantity.to(target).magnitude)
 
 
-def _parse(text: str, dimension: str) -> Any:
-    """Parse ``text`` with pint (``g`` = standard gravity for accelerations)."""
+def _parse(text: str, dimension: str, shown: str | None = None) -> Any:
+    """Parse ``text`` with pint (``g`` = standard gravity for accelerations).
+
+    ``shown`` is the string quoted in error messages (default ``text``).
+    """
     ureg = registry()
     expr = text
     if dimension == "acceleration":
@@ -147,7 +176,7 @@ def _parse(text: str, dimension: str) -> Any:
     except Exception as exc:  # pint raises many types (UndefinedUnitError, tokenize, ...)
         detail = str(exc).strip() or type(exc).__name__
         raise _UnitProblem(
-            f'cannot read "{text}" ({detail}); expected {describe_dimension(dimension)}'
+            f'cannot read "{shown or text}" ({detail}); expected {describe_dimension(dimension)}'
         ) from None
     if not hasattr(quantity, "dimensionality"):  # a bare number
         quantity = ureg.Quantity(quantity)
@@ -182,18 +211,31 @@ def _convert(value: Any, dimension: str) -> float:
         try:
             out = float(text)  # a number written as a string: SI
         except ValueError:
-            if not _NUMBER_START.match(text):
+            if not (_NUMBER_START.match(text) or _NUMBER_UNIT.match(text)):
                 raise _UnitProblem(
                     f'cannot read "{value}": expected a number followed by a unit, '
                     f"{describe_dimension(dimension)}"
                 ) from None
-            out = _quantity_to_si(_parse(text, dimension), text, dimension)
+            m = _NUMBER_UNIT.match(text)
+            if m is not None:
+                # "<number> <unit>": convert the unit alone, multiply in decimal (see scale_decimal)
+                factor = _quantity_to_si(_parse(m.group("unit"), dimension, text), text, dimension)
+                number = m.group("number")
+                special = number.lower().lstrip("+-")
+                if special == "nan":
+                    out = math.nan
+                elif special.startswith("inf"):
+                    out = float(number)
+                else:
+                    out = scale_decimal(number, factor)
+            else:
+                out = _quantity_to_si(_parse(text, dimension), text, dimension)
     else:
         out = float(value)
     if math.isnan(out):
         raise _UnitProblem(f"NaN is not a valid value (expected {describe_dimension(dimension)})")
     if math.isinf(out) and dimension not in _STIFFNESSES:
-        raise _UnitProblem(f"must be finite, got {value!r}")
+        raise _UnitProblem(f"must be finite, got {value!r} (expected {describe_dimension(dimension)})")
     return out
 
 

@@ -55,6 +55,21 @@ class ModalDynamics:
     rigid: np.ndarray = None  # type: ignore[assignment]
     all_under: bool = False
 
+    def grid_table(self, h: float, n: int) -> np.ndarray:
+        """``exp(mu_n h j)``, ``mu_n = -a_n + i w_dn``, j = 0..n-1 (under-damped modes; cached).
+
+        Each entry is computed directly (no recurrence), so a uniform grid costs
+        one complex product per mode and point instead of exp, cos and sin.
+        """
+        cache = self.__dict__.setdefault("_tables", {})
+        tab = cache.get(h)
+        if tab is None or tab.shape[1] < n:
+            m = max(n, 256 if tab is None else 2 * tab.shape[1])
+            mu = (-self.decay + 1j * self.wd)[:, None]
+            tab = np.exp(mu * (h * np.arange(m))[None, :])
+            cache[h] = tab
+        return tab[:, :n]
+
     def kernels(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``exp(-a tau) C(tau)`` and ``exp(-a tau) S(tau)``, shape (n, p)."""
         tau = np.asarray(tau, dtype=float)[None, :]
@@ -108,7 +123,7 @@ class ClosedFormSegment:
         Modal displacement and velocity at ``tau = 0``.
     """
 
-    __slots__ = ("dyn", "load", "h0", "dh0", "_Hc", "_res")
+    __slots__ = ("dyn", "load", "h0", "dh0", "_Hc", "_res", "_A", "_B", "_pcoef")
 
     def __init__(self, dyn: ModalDynamics, load: LoadForm, eta0: np.ndarray, deta0: np.ndarray) -> None:
         self.dyn = dyn
@@ -126,6 +141,110 @@ class ClosedFormSegment:
         p0, dp0 = self._particular(np.zeros(1))
         self.h0 = eta0 - p0[:, 0]
         self.dh0 = deta0 - dp0[:, 0]
+        # under-damped homogeneous part: eta_h = Re(A E), eta_h' = Re(B E), E = exp(mu tau)
+        wd = np.where(dyn.under, dyn.wd, 1.0)
+        a = dyn.decay
+        self._A = np.where(dyn.under, self.h0 - 1j * (a * self.h0 + self.dh0) / wd, 0.0)
+        self._B = np.where(dyn.under, self.dh0 - 1j * (-(dyn.omega**2) * self.h0 - a * self.dh0) / wd, 0.0)
+        self._pcoef = None
+
+    def _particular_coefficients(self) -> np.ndarray:
+        """Per-mode coefficients of the particular solution on the basis
+        ``1, tau, tau^2, tau^3, Im(z), sin(theta), tau cos(theta)`` (``z = exp(i theta)``,
+        ``theta = Omega tau + phi``), complex for the ``Im(z)`` column: shape (n, 7)."""
+        if self._pcoef is not None:
+            return self._pcoef
+        dyn, ld = self.dyn, self.load
+        n = dyn.omega.size
+        C = np.zeros((n, 7), dtype=complex)
+        rig = dyn.rigid
+        om = np.where(rig, 1.0, dyn.omega)
+        om2 = om**2
+        C[:, 0] = np.where(rig, 0.0, ld.a / om2)
+        C[:, 2] = np.where(rig, 0.5 * ld.a, 0.0)
+        if ld.b is not None:
+            C[:, 0] += np.where(rig, 0.0, -2.0 * dyn.xi * ld.b / (om * om2))
+            C[:, 1] = np.where(rig, 0.0, ld.b / om2)
+            C[:, 3] = np.where(rig, ld.b / 6.0, 0.0)
+        if ld.d is not None:
+            C[:, 4] = ld.d * self._Hc
+            if rig.any():
+                C[:, 5] = np.where(rig, -ld.d / ld.Omega**2, 0.0)
+            if self._res is not None:
+                C[:, 6] = np.where(self._res, -ld.d / (2.0 * om), 0.0)
+        self._pcoef = C
+        return C
+
+    def _particular_grid(self, V: np.ndarray | None, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``V @ P(tau)`` and its derivative (V None: per mode)."""
+        C = self._particular_coefficients()
+        if V is not None:
+            C = V @ C
+        t = tau[None, :]
+        ld = self.load
+        val = C[:, 0:1].real + C[:, 1:2].real * t
+        der = np.broadcast_to(C[:, 1:2].real, val.shape).copy()
+        if np.any(C[:, 2]) or np.any(C[:, 3]):
+            val = val + C[:, 2:3].real * t**2 + C[:, 3:4].real * t**3
+            der = der + 2.0 * C[:, 2:3].real * t + 3.0 * C[:, 3:4].real * t**2
+        if ld.d is not None:
+            W = ld.Omega
+            theta = W * tau + ld.phi
+            z = np.exp(1j * theta)[None, :]
+            cz = C[:, 4:5] * z
+            val = val + cz.imag
+            der = der + W * cz.real
+            if np.any(C[:, 5]):
+                val = val + C[:, 5:6].real * z.imag
+                der = der + W * C[:, 5:6].real * z.real
+            if np.any(C[:, 6]):
+                val = val + C[:, 6:7].real * t * z.real
+                der = der + C[:, 6:7].real * (z.real - W * t * z.imag)
+        return val, der
+
+    def evaluate_grid(self, tau0: float, h: float, n: int, V: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Response on the uniform grid ``tau0 + h j`` (j < n), optionally projected.
+
+        Returns ``V @ eta`` and ``V @ eta'`` (shape (m, n)), or the modal arrays
+        (n_modes, n) when ``V`` is None. Exact, like :meth:`evaluate`.
+        """
+        dyn = self.dyn
+        tau = tau0 + h * np.arange(n)
+        P, dP = self._particular_grid(V, tau)
+        under = dyn.under
+        if under.any():
+            R = dyn.grid_table(h, n)
+            mu = -dyn.decay + 1j * dyn.wd
+            e0 = np.exp(mu * tau0)
+            A = self._A * e0
+            B = self._B * e0
+            if V is None:
+                E = R * 1.0
+                val = (A[:, None] * E).real
+                der = (B[:, None] * E).real
+            else:
+                val = ((V * A[None, :]) @ R).real
+                der = ((V * B[None, :]) @ R).real
+        else:
+            shape = P.shape
+            val = np.zeros(shape)
+            der = np.zeros(shape)
+        if not dyn.all_under:
+            other = ~under
+            eC, eS = ModalDynamics(dyn.omega[other], dyn.xi[other]).kernels(tau)
+            a = dyn.decay[other][:, None]
+            h0 = self.h0[other][:, None]
+            dh0 = self.dh0[other][:, None]
+            om2 = (dyn.omega[other] ** 2)[:, None]
+            eta = (eC + a * eS) * h0 + eS * dh0
+            deta = -om2 * eS * h0 + (eC - a * eS) * dh0
+            if V is None:
+                val[other] += eta
+                der[other] += deta
+            else:
+                val = val + V[:, other] @ eta
+                der = der + V[:, other] @ deta
+        return val + P, der + dP
 
     def _particular(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         dyn, ld = self.dyn, self.load
@@ -156,7 +275,7 @@ class ClosedFormSegment:
                 dP = dP + np.where(r, -d * np.cos(theta) / W, 0.0)
             if self._res is not None:
                 r = self._res[:, None]
-                w = om
+                w = np.where(rig, 1.0, om)
                 P = P + np.where(r, -d * t * np.cos(theta) / (2.0 * w), 0.0)
                 dP = dP + np.where(r, -d * np.cos(theta) / (2.0 * w) + 0.5 * d * t * np.sin(theta), 0.0)
         return P, dP
