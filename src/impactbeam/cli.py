@@ -345,10 +345,10 @@ def info() -> None:
 # Wrap each command body with @handle_errors so bad input exits 2 with one line.
 # ============================================================================
 
-
-if __name__ == "__main__":
-    main()
-
 from .commands import register as _register_commands  # noqa: E402
 
 _register_commands(main)
+
+
+if __name__ == "__main__":
+    main()
