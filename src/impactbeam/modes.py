@@ -547,10 +547,16 @@ class ModeSet:
     def _quad(self) -> tuple[np.ndarray, np.ndarray]:
         return _quadrature(self.nodes, float(self.beta.max(initial=1.0 / self.beam.length)))
 
+    @functools.cached_property
+    def _integral(self) -> np.ndarray:
+        x, w = self._quad
+        out = self.shapes(x) @ w
+        out.setflags(write=False)
+        return out
+
     def integral(self) -> np.ndarray:
         """``int_0^L W_n dx`` [m kg^-0.5], shape (n,): modal weight of a uniform load."""
-        x, w = self._quad
-        return self.shapes(x) @ w
+        return self._integral.copy()
 
     def mass_matrix(self) -> np.ndarray:
         """``rho A int W_n W_m dx``: the identity up to round-off (a check)."""
@@ -564,10 +570,17 @@ class ModeSet:
         """
         if other.beam != self.beam:
             raise ParameterError("overlap: the two mode sets belong to different beams")
+        cache = self.__dict__.setdefault("_overlaps", {})
+        hit = cache.get(id(other))
+        if hit is not None and hit[0] is other:
+            return hit[1].copy()
         breaks = np.union1d(self.nodes, other.nodes)
         bmax = max(float(self.beta.max(initial=0.0)), float(other.beta.max(initial=0.0)), 1.0 / self.beam.length)
         x, w = _quadrature(breaks, bmax)
-        return self.beam.mass_per_length * (self.shapes(x) * w) @ other.shapes(x).T
+        P = self.beam.mass_per_length * (self.shapes(x) * w) @ other.shapes(x).T
+        P.setflags(write=False)
+        cache[id(other)] = (other, P)
+        return P.copy()
 
     def static_coordinates(self, position: float, force: float = 1.0) -> np.ndarray:
         """Modal coordinates of the static deflection under a point ``force`` at ``position``.

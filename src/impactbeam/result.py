@@ -141,14 +141,19 @@ class SimulationResult:
         idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(segs) - 1)
         out = np.full((x.size, t.size), np.nan)
         space = self._raw.space
+        cache = self.__dict__.setdefault("_shape_cache", {})
+        xkey = x.tobytes()
         for j in np.unique(idx):
             seg = segs[j]
             sel = (idx == j) & (t <= seg.t1 + 1e-15)
             if not sel.any():
                 continue
-            ms = space.state(seg.engaged).modes
+            W = cache.get((seg.engaged, xkey))
+            if W is None:
+                W = space.state(seg.engaged).modes.shapes(x).T
+                cache[(seg.engaged, xkey)] = W
             eta, deta = seg.solution.evaluate(t[sel] - seg.t0)
-            out[:, sel] = ms.shapes(x).T @ (eta if which == 0 else deta)
+            out[:, sel] = W @ (eta if which == 0 else deta)
         return out
 
     def displacement(self, x, t) -> np.ndarray:

@@ -19,6 +19,7 @@ integrated exactly.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -201,6 +202,41 @@ class ClosedFormSegment:
                 val = val + C[:, 6:7].real * t * z.real
                 der = der + C[:, 6:7].real * (z.real - W * t * z.imag)
         return val, der
+
+    def projector(self, v: np.ndarray, offset: float = 0.0):
+        """Fast scalar ``tau -> (offset + v @ eta(tau), v @ eta'(tau))`` for root finding."""
+        dyn = self.dyn
+        if not dyn.all_under:
+            def general(tau: float) -> tuple[float, float]:
+                e, d = self.evaluate(np.array([tau]))
+                return offset + float(v @ e[:, 0]), float(v @ d[:, 0])
+
+            return general
+        mu = -dyn.decay + 1j * dyn.wd
+        vA = v * self._A
+        vB = v * self._B
+        c = v @ self._particular_coefficients()
+        c0, c1, c2, c3 = (float(c[i].real) for i in range(4))
+        c4 = complex(c[4])
+        c5, c6 = float(c[5].real), float(c[6].real)
+        ld = self.load
+        W, phi = ld.Omega, ld.phi
+        has_sin = ld.d is not None
+        exp = np.exp
+
+        def f(tau: float) -> tuple[float, float]:
+            E = exp(mu * tau)
+            val = offset + (vA @ E).real + c0 + tau * (c1 + tau * (c2 + tau * c3))
+            der = (vB @ E).real + c1 + tau * (2.0 * c2 + 3.0 * c3 * tau)
+            if has_sin:
+                th = W * tau + phi
+                z = complex(math.cos(th), math.sin(th))
+                cz = c4 * z
+                val += cz.imag + c5 * z.imag + c6 * tau * z.real
+                der += W * cz.real + W * c5 * z.real + c6 * (z.real - W * tau * z.imag)
+            return float(val), float(der)
+
+        return f
 
     def evaluate_grid(self, tau0: float, h: float, n: int, V: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Response on the uniform grid ``tau0 + h j`` (j < n), optionally projected.

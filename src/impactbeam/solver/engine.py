@@ -211,16 +211,14 @@ class _Integrator:
 
     # ------------------------------------------------------------------ event location
     def _locate(self, st, seg, orient, c: int, lo: float, hi: float, hlo: float, dlo: float, dhi: float) -> float | None:
-        W = st.W_contact[c]
         o, s, gap = orient[c], self.side[c], self.gap[c]
+        f = seg.projector(-o * s * st.W_contact[c], o * gap)
 
         def h(t: float) -> float:
-            e, _ = seg.evaluate(np.array([t]))
-            return float(o * (gap - s * (W @ e[:, 0])))
+            return f(t)[0]
 
         def dh(t: float) -> float:
-            _, d = seg.evaluate(np.array([t]))
-            return float(-o * s * (W @ d[:, 0]))
+            return f(t)[1]
 
         tol = self.opt.event_tolerance
         hh = h(hi)
@@ -315,86 +313,97 @@ class _Integrator:
         return new, eta, deta
 
     def _advance(self, st: StateModel, seg: ClosedFormSegment, orient, t0: float, t_end: float):
-        """Evaluate and store output on [t0, t_end); return (end time, contactor hit or None)."""
+        """Scan [t0, t_end] for the first event; store the output; return (end time, contactor hit or None)."""
+        hit_tau, hit_c = None, None
+        if self.contactors:
+            hit_tau, hit_c = self._scan(st, seg, orient, t0, t_end)
+        t1 = t_end if hit_tau is None else t0 + hit_tau
+        self._output(st, seg, t0, t1)
+        return t1, hit_c
+
+    def _scan(self, st: StateModel, seg: ClosedFormSegment, orient, t0: float, t_end: float):
         h = self.h
-        sub = self.sub
         k = math.ceil(t0 / h - 1e-9)
-        if k * h < t0:
-            k += 1
         k_last = math.floor(t_end / h + 1e-9)
-        e0, d0 = seg.evaluate(np.zeros(1))
-        hp, dhp, _, _ = self._h(st, orient, e0, d0)
-        hp, dhp = hp[:, 0], dhp[:, 0]
+        V = (orient * -self.side)[:, None] * st.W_contact  # h = orient (gap - s w) = orient*gap + V @ eta
+        base = (orient * self.gap)[:, None]
+        hv, dv = seg.evaluate_grid(0.0, h, 1, V)
+        hp, dhp = hv[:, 0] + base[:, 0], dv[:, 0]
         tau_prev = 0.0
-        code = self._code(st.engaged)
-        has_c = len(self.contactors) > 0
+        n_chunk = 256
         while True:
-            k_hi = min(k + _CHUNK, k_last + 1)
-            taus = np.arange(k, k_hi) * h - t0
-            append_end = k_hi > k_last and (t_end - t0) > (taus[-1] if taus.size else -1.0) + 1e-15
-            tau_eval = np.append(taus, t_end - t0) if append_end else taus
-            if tau_eval.size == 0:
-                return t_end, None
-            eta, deta = seg.evaluate(tau_eval)
-            hit_tau, hit_c = None, None
-            if has_c:
-                H, dH, _, _ = self._h(st, orient, eta, deta)
+            n = max(0, min(n_chunk, k_last + 1 - k))
+            tau0 = k * h - t0
+            if n:
+                H, dH = seg.evaluate_grid(tau0, h, n, V)
+                H = H + base
+                taus = tau0 + h * np.arange(n)
+            else:
+                H = np.zeros((V.shape[0], 0))
+                dH = H
+                taus = np.zeros(0)
+            last = k + n > k_last
+            if last and (t_end - t0) > (taus[-1] if n else 0.0) + 1e-15:
+                He, dHe = seg.evaluate_grid(t_end - t0, h, 1, V)
+                H = np.concatenate([H, He + base], axis=1)
+                dH = np.concatenate([dH, dHe], axis=1)
+                taus = np.append(taus, t_end - t0)
+            if taus.size:
                 Hprev = np.concatenate([hp[:, None], H[:, :-1]], axis=1)
                 dHprev = np.concatenate([dhp[:, None], dH[:, :-1]], axis=1)
-                tprev = np.concatenate([[tau_prev], tau_eval[:-1]])
+                tprev = np.concatenate([[tau_prev], taus[:-1]])
                 start_touch = np.abs(Hprev) <= self.tol_h
                 cross = (H <= 0.0) & ((Hprev > 0.0) | (start_touch & (dHprev > 0)))
-                dtau = tau_eval - tprev
+                dtau = taus - tprev
                 graze = (Hprev > 0) & (H > 0) & (dHprev < 0) & (dH > 0)
                 graze &= (Hprev < np.abs(dHprev) * dtau) | (H < np.abs(dH) * dtau)
                 cand = cross | graze
                 if cand.any():
-                    cols = np.nonzero(cand.any(axis=0))[0]
-                    for j in cols:
+                    for j in np.nonzero(cand.any(axis=0))[0]:
                         best = None
                         for c in np.nonzero(cand[:, j])[0]:
-                            r = self._locate(st, seg, orient, int(c), tprev[j], tau_eval[j], Hprev[c, j], dHprev[c, j], dH[c, j])
+                            r = self._locate(
+                                st, seg, orient, int(c), tprev[j], taus[j], Hprev[c, j], dHprev[c, j], dH[c, j]
+                            )
                             if r is not None and (best is None or r < best[0]):
                                 best = (r, int(c))
                         if best is not None:
-                            hit_tau, hit_c = best
-                            break
-            n_keep = taus.size if hit_tau is None else int(np.searchsorted(taus, hit_tau, side="left"))
-            self._store(st, seg, code, k, taus[:n_keep], eta[:, :n_keep], deta[:, :n_keep])
-            if hit_tau is not None:
-                return t0 + hit_tau, hit_c
-            if k_hi > k_last:
-                return t_end, None
-            hp, dhp = (H[:, -1], dH[:, -1]) if has_c else (hp, dhp)
-            tau_prev = tau_eval[-1]
-            k = k_hi
+                            return best
+                hp, dhp = H[:, -1], dH[:, -1]
+                tau_prev = taus[-1]
+            if last:
+                return None, None
+            k += n
+            n_chunk = min(2 * n_chunk, 8192)
 
-    def _store(self, st, seg, code, k0, taus, eta, deta) -> None:
-        if taus.size == 0:
-            return
-        ks = k0 + np.arange(taus.size)
-        sel = ks % self.sub == 0
-        if not sel.any():
-            return
-        idx = ks[sel] // self.sub
-        ok = idx < self.n_out
-        idx = idx[ok]
-        e = eta[:, sel][:, ok]
-        d = deta[:, sel][:, ok]
-        self.w[idx] = (st.W_out @ e).T
-        self.w_t[idx] = (st.W_out @ d).T
-        if self.contactors:
-            self.wc[idx] = (st.W_contact @ e).T
-            self.wtc[idx] = (st.W_contact @ d).T
-        self.code[idx] = code
-        self.kin[idx] = 0.5 * np.sum(d**2, axis=0)
-        self.strain[idx] = 0.5 * np.sum((st.modes.omega[:, None] * e) ** 2, axis=0)
-        f = seg.force(taus[sel][ok]) - st.gap_force[:, None]
-        self.lpow[idx] = np.sum(f * d, axis=0)
-        self.dpow[idx] = np.sum((2.0 * st.dyn.decay)[:, None] * d**2, axis=0)
-        n = e.shape[0]
-        self.eta[idx, :n] = e.T
-        self.eta_t[idx, :n] = d.T
+    def _output(self, st: StateModel, seg: ClosedFormSegment, t0: float, t1: float) -> None:
+        """Exact output at the sampling times in [t0, t1) (t1 included at the end of the run)."""
+        dt = self.opt.time_step
+        i0 = max(0, math.ceil(t0 / dt - 1e-9))
+        i1 = self.n_out if t1 >= self.opt.end_time else min(self.n_out, math.ceil(t1 / dt - 1e-9))
+        code = self._code(st.engaged)
+        om = st.modes.omega[:, None]
+        damp2 = (2.0 * st.dyn.decay)[:, None]
+        for a in range(i0, i1, 8192):
+            b = min(a + 8192, i1)
+            tau0 = a * dt - t0
+            eta, deta = seg.evaluate_grid(tau0, dt, b - a)
+            sl = slice(a, b)
+            self.w[sl] = (st.W_out @ eta).T
+            self.w_t[sl] = (st.W_out @ deta).T
+            if self.contactors:
+                self.wc[sl] = (st.W_contact @ eta).T
+                self.wtc[sl] = (st.W_contact @ deta).T
+            self.code[sl] = code
+            self.kin[sl] = 0.5 * np.einsum("ij,ij->j", deta, deta)
+            oe = om * eta
+            self.strain[sl] = 0.5 * np.einsum("ij,ij->j", oe, oe)
+            f = seg.force(tau0 + dt * np.arange(b - a)) - st.gap_force[:, None]
+            self.lpow[sl] = np.einsum("ij,ij->j", f, deta)
+            self.dpow[sl] = np.einsum("ij,ij->j", damp2 * deta, deta)
+            n = eta.shape[0]
+            self.eta[sl, :n] = eta.T
+            self.eta_t[sl, :n] = deta.T
 
 
 def integrate(

@@ -20,6 +20,12 @@ from .options import Damping
 
 __all__ = ["StateModel", "StateSpace"]
 
+# State models are pure functions of their inputs (all immutable), so they are
+# shared between simulations: a parameter study that varies only the load or
+# the gaps reuses modes, shapes at the points and projections.
+_STATE_CACHE: dict[tuple, StateModel] = {}
+_STATE_CACHE_SIZE = 256
+
 
 @dataclass(frozen=True, eq=False)
 class StateModel:
@@ -79,7 +85,16 @@ class StateSpace:
     def state(self, engaged: tuple[int, ...]) -> StateModel:
         st = self._states.get(engaged)
         if st is None:
-            st = self._build(engaged)
+            key = (
+                self.beam, self.contactors, engaged, self.damping, self.excitation.kind,
+                self.excitation.position, self.n_modes, tuple(self.points.tolist()),
+            )
+            st = _STATE_CACHE.get(key)
+            if st is None:
+                st = self._build(engaged)
+                if len(_STATE_CACHE) >= _STATE_CACHE_SIZE:
+                    _STATE_CACHE.pop(next(iter(_STATE_CACHE)))
+                _STATE_CACHE[key] = st
             self._states[engaged] = st
         return st
 

@@ -1,0 +1,384 @@
+"""Independent reference integrator: the same modal model by :func:`scipy.integrate.solve_ivp`.
+
+``simulate(..., method="ivp")`` runs this path. It integrates the same
+piecewise-linear modal equations as the exact solver (paper eq. 9),
+
+.. math:: \\ddot\\eta_n + 2\\xi_n\\omega_n\\dot\\eta_n + \\omega_n^2\\eta_n
+          = p_n u(t) + f^{gap}_n,
+
+in each state (the set of engaged contactors, with the same mode sets from
+:class:`~impactbeam.solver.states.StateSpace`), but by a general-purpose
+Runge-Kutta method (DOP853, ``rtol = 1e-10``) instead of the closed form,
+with the time history ``u(t)`` taken from :meth:`Excitation.history` rather
+than from the closed-form load pieces. Contact changes are terminal
+``solve_ivp`` events on each contactor's opening ``g = c - s w(a)`` with a
+direction (downward crossing while open: impact; upward crossing while
+engaged: rebound); the integration restarts in the new state after the
+projection of the displacement and velocity (paper eq. 12). The integration
+is also restarted at every break of the load history (pulse start and end,
+table samples), so no step straddles a discontinuity of the load or of its
+derivative.
+
+It exists so the tests can check the exact solver against an integrator
+that shares none of its propagation or event-location code. It is about
+two orders of magnitude slower.
+
+Limitations (those of :func:`scipy.integrate.solve_ivp`): events are found
+from sign changes between accepted steps, so a graze that dips below the
+surface and back within one step is missed; the step is bounded by
+``max_step`` (1/4 of the shortest modal period of any state) to make that
+unlikely. Event times are located on the DOP853 dense output, accurate to
+about the integration tolerance, not to 1e-13 s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..beam import Beam, Contactor
+from ..exceptions import SimulationError
+from ..loading import Excitation, InitialCondition
+from .engine import Event, RawSolution, initial_coordinates
+from .options import Damping, SolverOptions
+from .states import StateModel, StateSpace
+
+__all__ = ["integrate_ivp", "IvpSegment", "IvpDense", "RTOL"]
+
+#: Relative tolerance of the reference integration.
+RTOL = 1e-10
+
+
+class IvpDense:
+    """Dense output of one ``solve_ivp`` run in one state, in the segment's local time.
+
+    ``evaluate(tau)`` returns the modal displacement and velocity at
+    ``t0 + tau``, each of shape (n, p), like
+    :meth:`~impactbeam.solver.closed_form.ClosedFormSegment.evaluate`.
+    """
+
+    __slots__ = ("sol", "t0", "y0", "y1", "t1", "n")
+
+    def __init__(self, sol, t0: float, t1: float, y0: np.ndarray, y1: np.ndarray) -> None:
+        self.sol = sol
+        self.t0 = t0
+        self.t1 = t1
+        self.y0 = y0
+        self.y1 = y1
+        self.n = y0.size // 2
+
+    def evaluate(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        tau = np.atleast_1d(np.asarray(tau, dtype=float))
+        if self.sol is None:  # zero-length segment (two events at one instant)
+            y = np.repeat(self.y0[:, None], tau.size, axis=1)
+        else:
+            y = np.asarray(self.sol(self.t0 + tau)).reshape(2 * self.n, tau.size)
+        return y[: self.n], y[self.n :]
+
+
+@dataclass(frozen=True, eq=False)
+class IvpSegment:
+    """One state on ``[t0, t1]`` with its ``solve_ivp`` dense output."""
+
+    t0: float
+    t1: float
+    engaged: tuple[int, ...]
+    solution: IvpDense
+
+
+def _load_breaks(excitation: Excitation, end_time: float) -> list[float]:
+    """Times in (0, end_time) where the load history or its derivative jumps."""
+    if not excitation.active:
+        return []
+    s = excitation.start
+    if excitation.shape == "half_sine":
+        assert excitation.duration is not None
+        cand = [s, s + excitation.duration]
+    elif excitation.shape == "step":
+        cand = [s]
+    else:
+        assert excitation.times is not None
+        cand = list(s + excitation.times)
+    return sorted({float(t) for t in cand if 0.0 < t < end_time})
+
+
+def _history_on(excitation: Excitation, a: float, b: float):
+    """``u(t)`` on the open interval (a, b), continued to its closed ends from inside.
+
+    :meth:`Excitation.history` is right-continuous at the breaks; a
+    Runge-Kutta stage evaluated exactly at ``b`` must see the value of this
+    interval, so times are pulled inside by 1e-9 of the interval (a force
+    error of that relative size on stages at the very ends only).
+    """
+    if not excitation.active:
+        return lambda t: 0.0
+    d = 1e-9 * (b - a)
+    lo, hi = a + d, b - d
+
+    def u(t: float) -> float:
+        return float(excitation.history(np.array([min(max(t, lo), hi)]))[0])
+
+    return u
+
+
+class _Reference:
+    def __init__(
+        self,
+        beam: Beam,
+        contactors: tuple[Contactor, ...],
+        damping: Damping,
+        excitation: Excitation,
+        options: SolverOptions,
+        points: np.ndarray,
+    ) -> None:
+        self.beam = beam
+        self.contactors = contactors
+        self.excitation = excitation
+        self.opt = options
+        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, points)
+        self.gap = np.array([c.gap for c in contactors], dtype=float)
+        self.side = np.array([c.direction for c in contactors], dtype=float)
+        self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
+        T = options.end_time
+        dt = options.time_step
+        self.n_out = int(math.floor(T / dt * (1.0 + 1e-12))) + 1
+        self.time = np.arange(self.n_out) * dt
+        all_eng = tuple(range(len(contactors)))
+        states = [self.space.state(())] + ([self.space.state(all_eng)] if contactors else [])
+        wmax = max(st.omega_max for st in states)
+        self.max_step = 0.25 * 2.0 * math.pi / wmax if wmax > 0 else math.inf
+        self.max_step = min(self.max_step, T)
+
+    # -------------------------------------------------------------- pieces of the model
+    def gap_force(self, st: StateModel) -> np.ndarray:
+        """Modal weights of the constant force ``s k c`` of each engaged gapped contactor.
+
+        Contactor ``above`` (s = +1) engaged pushes with ``-k (w - c) = -k w + k c``;
+        the ``-k w`` part is in the contact-state modes, ``+k c`` remains.
+        """
+        f = np.zeros(st.modes.count)
+        for i in st.engaged:
+            f += self.side[i] * self.stiff[i] * self.gap[i] * st.W_contact[i]
+        return f
+
+    def energy(self, st: StateModel, eta: np.ndarray, deta: np.ndarray) -> float:
+        """Kinetic + strain (beam, supports) + engaged contactor springs ``1/2 k g^2``."""
+        E = 0.5 * float(deta @ deta) + 0.5 * float(np.sum((st.modes.omega * eta) ** 2))
+        wc = st.W_contact @ eta
+        for i in st.engaged:
+            g = self.gap[i] - self.side[i] * wc[i]
+            # the modal strain already holds 1/2 k w^2 of the engaged spring
+            E += 0.5 * self.stiff[i] * (g**2 - wc[i] ** 2)
+        return E
+
+    def atol(self, st: StateModel, y0: np.ndarray) -> np.ndarray:
+        """Absolute tolerance per component: 1e-3 rtol of a characteristic modal amplitude."""
+        n = st.modes.count
+        om = st.modes.omega
+        om_el = om[om > 0]
+        w_ref = float(om_el.min()) if om_el.size else 2.0 * math.pi / self.opt.end_time
+        u_max = 0.0
+        if self.excitation.active:
+            tt = np.linspace(0.0, self.opt.end_time, 2001)
+            u_max = float(np.max(np.abs(self.excitation.history(tt))))
+            if self.excitation.shape == "table":
+                u_max = max(u_max, float(np.max(np.abs(self.excitation.values))) * abs(self.excitation.scale))
+        U = max(
+            float(np.max(np.abs(y0[:n]), initial=0.0)),
+            float(np.max(np.abs(y0[n:]), initial=0.0)) / w_ref,
+            u_max * float(np.max(np.abs(st.load_weights), initial=0.0)) / w_ref**2,
+            float(np.sum(self.stiff * self.gap * np.max(np.abs(st.W_contact), axis=1))) / w_ref**2
+            if self.contactors
+            else 0.0,
+            1e-300,
+        )
+        a = RTOL * 1e-3 * U
+        return np.concatenate([np.full(n, a), np.full(n, a * w_ref)])
+
+    # -------------------------------------------------------------- main loop
+    def run(self, eta: np.ndarray, deta: np.ndarray) -> RawSolution:
+        T = self.opt.end_time
+        breaks = _load_breaks(self.excitation, T) + [T]
+        engaged: tuple[int, ...] = ()
+        t = 0.0
+        k_break = 0
+        events: list[Event] = []
+        segments: list[IvpSegment] = []
+        jumps: list[float] = []
+        status, message = 0, "The simulation reached end_time."
+        nc = len(self.contactors)
+        same_instant: dict[int, int] = {}
+        last_t = -1.0
+        atol_state: dict[tuple[int, ...], np.ndarray] = {}
+        while t < T:
+            while breaks[k_break] <= t:
+                k_break += 1
+            t_stop = breaks[k_break]
+            a_int = breaks[k_break - 1] if k_break > 0 else 0.0
+            st = self.space.state(engaged)
+            n = st.modes.count
+            om2 = st.modes.omega**2
+            c2 = 2.0 * st.dyn.decay
+            p = st.load_weights
+            fgap = self.gap_force(st)
+            u = _history_on(self.excitation, a_int, t_stop)
+
+            def rhs(tt, y, om2=om2, c2=c2, p=p, fgap=fgap, u=u, n=n):
+                e, d = y[:n], y[n:]
+                return np.concatenate([d, p * u(tt) + fgap - c2 * d - om2 * e])
+
+            evs = []
+            for c in range(nc):
+                Wc = st.W_contact[c]
+                g0, s0 = self.gap[c], self.side[c]
+
+                def ev(tt, y, Wc=Wc, g0=g0, s0=s0, n=n):
+                    return g0 - s0 * float(Wc @ y[:n])
+
+                ev.terminal = True
+                ev.direction = 1.0 if c in engaged else -1.0
+                evs.append(ev)
+            y0 = np.concatenate([eta, deta])
+            if engaged not in atol_state:
+                atol_state[engaged] = self.atol(st, y0)
+            sol = solve_ivp(
+                rhs, (t, t_stop), y0, method="DOP853", rtol=RTOL, atol=atol_state[engaged],
+                dense_output=True, events=evs or None, max_step=self.max_step,
+            )
+            if sol.status == -1:
+                raise SimulationError(f"solve_ivp failed at t = {t:.9g} s: {sol.message}")
+            hit: tuple[float, int] | None = None
+            if sol.status == 1:
+                for c, te in enumerate(sol.t_events):
+                    if te.size and (hit is None or te[0] < hit[0]):
+                        hit = (float(te[0]), c)
+            t1 = hit[0] if hit is not None else float(sol.t[-1])
+            y1 = sol.sol(t1) if sol.sol is not None else y0
+            segments.append(IvpSegment(t, t1, engaged, IvpDense(sol.sol, t, t1, y0, y1)))
+            eta, deta = y1[:n].copy(), y1[n:].copy()
+            t = t1
+            if hit is not None:
+                c = hit[1]
+                if t != last_t:
+                    same_instant, last_t = {}, t
+                same_instant[c] = same_instant.get(c, 0) + 1
+                new = tuple(sorted(set(engaged) ^ {c}))
+                kind = "impact" if c in new else "rebound"
+                E_before = self.energy(st, eta, deta)
+                if events and events[-1].time == t and events[-1].contactor == c:
+                    events.pop()  # an impact and a rebound at one instant cancel (grazing touch)
+                else:
+                    events.append(Event(t, kind, c, float(st.W_contact[c] @ deta)))
+                P = self.space.projection(new, engaged)
+                eta, deta = P @ eta, P @ deta
+                engaged = new
+                jumps.append(self.energy(self.space.state(new), eta, deta) - E_before)
+                if len(events) >= self.opt.max_events or same_instant[c] > 4:
+                    status = 1
+                    message = (
+                        f"Stopped at t = {t:.9g} s after {len(events)} events (solver.max_events): "
+                        "chattering contact; later samples are NaN."
+                    )
+                    break
+        return self._sample(segments, events, jumps, status, message, t)
+
+    # -------------------------------------------------------------- output
+    def _sample(self, segments, events, jumps, status, message, t_reached) -> RawSolution:
+        n_out, nm = self.n_out, self.opt.modes
+        npnt, nc = self.space.points.size, len(self.contactors)
+        nan = lambda *s: np.full(s, np.nan)  # noqa: E731
+        w, w_t = nan(n_out, npnt), nan(n_out, npnt)
+        wc, wtc = nan(n_out, nc), nan(n_out, nc)
+        kin, strain, lpow, dpow = nan(n_out), nan(n_out), nan(n_out), nan(n_out)
+        eta_all, deta_all = nan(n_out, nm), nan(n_out, nm)
+        code = np.full(n_out, -1, dtype=np.int16)
+        keys: list[tuple[int, ...]] = []
+        T = self.opt.end_time
+        for j, seg in enumerate(segments):
+            last = j == len(segments) - 1
+            if last and status == 0:
+                sel = (self.time >= seg.t0) & (self.time <= T * (1 + 1e-12))
+            else:
+                sel = (self.time >= seg.t0) & (self.time < seg.t1)
+            idx = np.nonzero(sel)[0]
+            if idx.size == 0:
+                continue
+            st = self.space.state(seg.engaged)
+            if seg.engaged not in keys:
+                keys.append(seg.engaged)
+            tau = np.minimum(self.time[idx], seg.t1) - seg.t0
+            e, d = seg.solution.evaluate(tau)
+            n = e.shape[0]
+            w[idx] = (st.W_out @ e).T
+            w_t[idx] = (st.W_out @ d).T
+            if nc:
+                wc[idx] = (st.W_contact @ e).T
+                wtc[idx] = (st.W_contact @ d).T
+            code[idx] = keys.index(seg.engaged)
+            kin[idx] = 0.5 * np.sum(d**2, axis=0)
+            strain[idx] = 0.5 * np.sum((st.modes.omega[:, None] * e) ** 2, axis=0)
+            uu = self.excitation.history(self.time[idx])
+            lpow[idx] = uu * (st.load_weights @ d)
+            dpow[idx] = np.sum((2.0 * st.dyn.decay)[:, None] * d**2, axis=0)
+            eta_all[idx, :n] = e.T
+            deta_all[idx, :n] = d.T
+        return RawSolution(
+            self.time, w, w_t, wc, wtc, code, keys, kin, strain, lpow, dpow, eta_all, deta_all,
+            events, segments, self.space, status, message, jumps,
+        )
+
+
+def integrate_ivp(
+    beam: Beam,
+    contactors: tuple[Contactor, ...],
+    damping: Damping,
+    excitation: Excitation,
+    initial: InitialCondition,
+    options: SolverOptions,
+    points: np.ndarray,
+) -> RawSolution:
+    """Integrate the modal model with :func:`scipy.integrate.solve_ivp` and terminal events.
+
+    Parameters
+    ----------
+    beam : Beam
+    contactors : tuple of Contactor
+    damping : Damping
+        Modal damping ratios of the free and contact states.
+    excitation : Excitation
+    initial : InitialCondition
+    options : SolverOptions
+        ``modes``, ``time_step`` (output sampling only), ``end_time``,
+        ``max_events`` (chattering guard, status 1).
+    points : ndarray, (n_points,), [m]
+        Output positions.
+
+    Returns
+    -------
+    RawSolution
+        The same container as the exact solver's
+        :func:`~impactbeam.solver.engine.integrate`, with ``segments`` holding
+        :class:`IvpSegment` objects whose ``solution.evaluate`` wraps the
+        DOP853 dense output, so :class:`~impactbeam.result.SimulationResult`
+        and its metrics work unchanged.
+
+    Raises
+    ------
+    SimulationError
+        If ``solve_ivp`` fails (step size underflow).
+
+    Notes
+    -----
+    DOP853 with ``rtol = 1e-10`` and an absolute tolerance of 1e-13 of a
+    characteristic modal amplitude; ``max_step`` is a quarter of the
+    shortest modal period. See the module docstring for what is shared with
+    the exact solver (mode sets, modal load weights, projection matrices)
+    and what is not (propagation, load evaluation, event detection and
+    location).
+    """
+    ref = _Reference(beam, tuple(contactors), damping, excitation, options, np.asarray(points, dtype=float))
+    eta, deta = initial_coordinates(beam, initial, options.modes)
+    return ref.run(eta, deta)
