@@ -127,7 +127,7 @@ _SCHEMA = _Table(
                 **_leaves("modal_displacement", "modal_velocity", list_ok=True, list_only=True),
             }
         ),
-        "solver": _Table(_leaves("modes", "time_step", "end_time", "max_events", "event_tolerance")),
+        "solver": _Table(_leaves("modes", "time_step", "end_time", "max_events", "event_tolerance", "projection")),
         "output": _Table(_leaves("points", "point_ratios", list_ok=True, list_only=True)),
     }
 )
@@ -729,6 +729,8 @@ def _parse_solver(raw: Mapping[str, Any]) -> SolverOptions:
     for name in ("time_step", "end_time", "event_tolerance"):
         if name in s:
             kw[name] = to_si(s[name], "time", f"solver.{name}")
+    if "projection" in s:
+        kw["projection"] = _choice("solver.projection", s["projection"], ("contact", "paper"))
     with _relabel("solver"):
         return SolverOptions(**kw)
 

@@ -155,6 +155,7 @@ class _Integrator:
         self.events: list[Event] = []
         self.segments: list[Segment] = []
         self.jumps: list[float] = []
+        self.projection_warning: str | None = None
 
     # ------------------------------------------------------------------ helpers
     def _code(self, engaged: tuple[int, ...]) -> int:
@@ -286,6 +287,8 @@ class _Integrator:
                     break
             elif t >= piece.t1:
                 k_piece += 1
+        if self.projection_warning is not None:
+            message = f"{message} Warning: {self.projection_warning}"
         return RawSolution(
             self.time, self.w, self.w_t, self.wc, self.wtc, self.code, self.keys, self.kin, self.strain,
             self.lpow, self.dpow, self.eta, self.eta_t, self.events, self.segments, self.space, status,
@@ -307,8 +310,18 @@ class _Integrator:
             self.events.pop()  # an impact and a rebound at one instant cancel (grazing touch)
         else:
             self.events.append(Event(t, kind, c, vel))
-        P = self.space.projection(new, engaged)
+        P = self.space.transfer(new, engaged, self.opt.projection == "contact")
+        w_before = st.W_contact @ eta
         eta, deta = P @ eta, P @ deta
+        moved = np.abs(self.space.state(new).W_contact @ eta - w_before)
+        scale = np.maximum(self.gap, np.abs(w_before)) + 1e-300
+        worst = int(np.argmax(moved / scale))
+        if moved[worst] > 0.05 * scale[worst] and self.projection_warning is None:
+            self.projection_warning = (
+                f"At t = {t:.6g} s the projection onto {self.opt.modes} modes moved the deflection at "
+                f"contactor {worst} by {moved[worst]:.3g} m ({100 * moved[worst] / scale[worst]:.0f} % of its gap "
+                "or deflection): the contactor is too stiff for this number of modes; add modes."
+            )
         self.jumps.append(self._energy(self.space.state(new), eta, deta) - E_before)
         return new, eta, deta
 

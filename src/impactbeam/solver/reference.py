@@ -9,8 +9,9 @@ piecewise-linear modal equations as the exact solver (paper eq. 9),
 in each state (the set of engaged contactors, with the same mode sets from
 :class:`~impactbeam.solver.states.StateSpace`), but by a general-purpose
 Runge-Kutta method (DOP853, ``rtol = 1e-10``) instead of the closed form,
-with the time history ``u(t)`` taken from :meth:`Excitation.history` rather
-than from the closed-form load pieces. Contact changes are terminal
+with the time history ``u(t)`` written out from the fields of the
+:class:`~impactbeam.loading.Excitation` rather than taken from the exact
+solver's closed-form load pieces. Contact changes are terminal
 ``solve_ivp`` events on each contactor's opening ``g = c - s w(a)`` with a
 direction (downward crossing while open: impact; upward crossing while
 engaged: rebound); the integration restarts in the new state after the
@@ -106,22 +107,40 @@ def _load_breaks(excitation: Excitation, end_time: float) -> list[float]:
 
 
 def _history_on(excitation: Excitation, a: float, b: float):
-    """``u(t)`` on the open interval (a, b), continued to its closed ends from inside.
+    """Scalar ``u(t)`` on the interval [a, b] between two breaks of the history.
 
-    :meth:`Excitation.history` is right-continuous at the breaks; a
-    Runge-Kutta stage evaluated exactly at ``b`` must see the value of this
-    interval, so times are pulled inside by 1e-9 of the interval (a force
-    error of that relative size on stages at the very ends only).
+    Written from the fields of :class:`Excitation` (amplitude, start,
+    duration, table), not from the exact solver's load pieces; the form is
+    fixed on the interval, so a Runge-Kutta stage at either end sees the
+    value of this interval (:meth:`Excitation.history` is right-continuous
+    at the breaks, which is wrong for a stage at ``b``).
     """
     if not excitation.active:
         return lambda t: 0.0
-    d = 1e-9 * (b - a)
-    lo, hi = a + d, b - d
-
-    def u(t: float) -> float:
-        return float(excitation.history(np.array([min(max(t, lo), hi)]))[0])
-
-    return u
+    s = excitation.scale
+    start = excitation.start
+    tau_mid = 0.5 * (a + b) - start
+    if excitation.shape == "half_sine":
+        dur = float(excitation.duration)  # type: ignore[arg-type]
+        if not 0.0 <= tau_mid <= dur:
+            return lambda t: 0.0
+        amp, om = s * excitation.amplitude, math.pi / dur
+        return lambda t: amp * math.sin(om * (t - start))
+    if excitation.shape == "step":
+        val = s * excitation.amplitude if tau_mid >= 0.0 else 0.0
+        return lambda t: val
+    tk, vk = excitation.times, excitation.values
+    assert tk is not None and vk is not None
+    if not tk[0] <= tau_mid <= tk[-1]:
+        return lambda t: 0.0
+    k = int(np.searchsorted(tk, tau_mid, side="right")) - 1
+    k = min(max(k, 0), tk.size - 2)
+    v0 = s * float(vk[k])
+    if excitation.hold == "constant":
+        return lambda t: v0
+    t0 = start + float(tk[k])
+    slope = s * float(vk[k + 1] - vk[k]) / float(tk[k + 1] - tk[k])
+    return lambda t: v0 + slope * (t - t0)
 
 
 class _Reference:
@@ -226,9 +245,16 @@ class _Reference:
             fgap = self.gap_force(st)
             u = _history_on(self.excitation, a_int, t_stop)
 
-            def rhs(tt, y, om2=om2, c2=c2, p=p, fgap=fgap, u=u, n=n):
-                e, d = y[:n], y[n:]
-                return np.concatenate([d, p * u(tt) + fgap - c2 * d - om2 * e])
+            # first-order form y' = A y + b u(t) + f: y = (eta, eta')
+            A = np.zeros((2 * n, 2 * n))
+            A[:n, n:] = np.eye(n)
+            A[n:, :n] = -np.diag(om2)
+            A[n:, n:] = -np.diag(c2)
+            bvec = np.concatenate([np.zeros(n), p])
+            fvec = np.concatenate([np.zeros(n), fgap])
+
+            def rhs(tt, y, A=A, bvec=bvec, fvec=fvec, u=u):
+                return A @ y + bvec * u(tt) + fvec
 
             evs = []
             for c in range(nc):

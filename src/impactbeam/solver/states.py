@@ -122,6 +122,27 @@ class StateSpace:
             self._proj[key] = P
         return P
 
+    def transfer(self, to: tuple[int, ...], frm: tuple[int, ...], preserve_contacts: bool) -> np.ndarray:
+        """Matrix ``T`` with ``eta_to = T @ eta_from`` (displacement and velocity alike).
+
+        Without ``preserve_contacts`` this is the projection of eq. (12). With it,
+        the nearest modal state (in the mass norm) to that projection whose
+        deflection at every contactor equals the old one:
+        ``T = P + C^T (C C^T)^+ (D - C P)`` with ``C = W_to(a)``, ``D = W_from(a)``.
+        """
+        key = (to, frm, preserve_contacts)
+        T = self._proj.get(key)  # type: ignore[arg-type]
+        if T is None:
+            P = self.projection(to, frm)
+            if preserve_contacts and self.contactors:
+                C = self.state(to).W_contact
+                D = self.state(frm).W_contact
+                T = P + C.T @ np.linalg.pinv(C @ C.T) @ (D - C @ P)
+            else:
+                T = P
+            self._proj[key] = T  # type: ignore[index]
+        return T
+
     @property
     def states(self) -> dict[tuple[int, ...], StateModel]:
         return self._states
