@@ -370,7 +370,7 @@ class _Integrator:
                 dtau = taus - tprev
                 graze = (Hprev > 0) & (H > 0) & (dHprev < 0) & (dH > 0)
                 graze &= (Hprev < np.abs(dHprev) * dtau) | (H < np.abs(dH) * dtau)
-                cand = cross | graze
+                cand = (cross | graze) & (dtau > 0.0)  # tau = 0 may be both ends of the first interval
                 if cand.any():
                     for j in np.nonzero(cand.any(axis=0))[0]:
                         best = None

@@ -304,8 +304,10 @@ class _Reference:
                 jumps.append(self.energy(self.space.state(new), eta, deta) - E_before)
                 if len(events) >= self.opt.max_events or same_instant[c] > 4:
                     status = 1
+                    why = "solver.max_events" if len(events) >= self.opt.max_events else (
+                        f"contactor {c} switched {same_instant[c]} times at one instant")
                     message = (
-                        f"Stopped at t = {t:.9g} s after {len(events)} events (solver.max_events): "
+                        f"Stopped at t = {t:.9g} s after {len(events)} events ({why}): "
                         "chattering contact; later samples are NaN."
                     )
                     break

@@ -1,0 +1,172 @@
+"""Benchmark: the exact solver against a straightforward SciPy ``solve_ivp`` modal model.
+
+Issue 6, item 5. Runs the reference Case 3 (examples/case03.toml: the
+specimen, 15 g / 15 ms half-sine base pulse, gap 0.229 mm, k = 4030 N/m at
+0.4840 L, xi 1.1 % / 2 %, 8 modes, output step 1e-5 s, 0.2 s) with
+``ib.simulate`` and with a baseline written here from scratch: the same 8
+free and 8 contact modes from ``ib.mode_set``, the modal equations
+integrated by ``solve_ivp`` (DOP853, rtol 1e-8), terminal events on the
+contactor's opening, the state switched and the modal displacement and
+velocity projected there (paper eq. 12). Both run in this process, one
+after the other; the script prints median times, their ratio and the
+difference of the metrics. It prints ratios, not pass/fail.
+
+Notes: the mode sets are cached (``ib.mode_set``, an LRU cache), and both
+methods are timed after a warm-up run, so neither timing includes the
+modal analysis. Run with ``python benchmarks/bench_solver.py [--repeats N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import time
+from pathlib import Path
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import numpy as np  # noqa: E402
+from scipy.integrate import solve_ivp  # noqa: E402
+from scipy.optimize import brentq  # noqa: E402
+
+import impactbeam as ib  # noqa: E402
+
+CASE = Path(__file__).resolve().parents[1] / "examples" / "case03.toml"
+
+
+def baseline(sc: ib.Scenario, rtol: float = 1e-8) -> dict:
+    """Case 3 by solve_ivp: modal equations, contact events, projection at switches.
+
+    Returns the metrics that the comparison uses: max of u = -w(a) (contactor above)
+    and its time, first impact time, duration of the first contact after the
+    maximum, number of impacts, and the event times.
+    """
+    beam, c = sc.beam, sc.contactors[0]
+    a, k, gap = c.position, c.stiffness, c.gap
+    s = 1.0 if c.side == "above" else -1.0
+    n = sc.solver.modes
+    T, dt = sc.solver.end_time, sc.solver.time_step
+    ex = sc.excitation
+    A, Td = ex.amplitude * ex.scale, ex.duration
+    rho_a = beam.mass_per_length
+    free = ib.mode_set(beam, (), n)
+    cont = ib.mode_set(beam, [(a, k)], n)
+    st = {}
+    for key, ms, xi in ((False, free, float(sc.damping.free)), (True, cont, float(sc.damping.contact))):
+        Wa = ms.shapes([a])[:, 0]
+        # base acceleration: modal load -rho A ug'' int W dx; engaged: constant force s k c W(a)
+        st[key] = dict(om2=ms.omega**2, c2=2 * xi * ms.omega, p=-rho_a * ms.integral(), Wa=Wa,
+                       f0=(s * k * gap * Wa) if key else np.zeros(n))
+    P = {True: cont.overlap(free), False: free.overlap(cont)}  # to-state <- from-state
+
+    def ug(t: float) -> float:
+        return A * math.sin(math.pi * t / Td) if t <= Td else 0.0
+
+    # absolute tolerance: rtol times 1e-3 of the quasi-static modal amplitude of the pulse
+    scale = abs(A) * float(np.max(np.abs(st[False]["p"]))) / float(free.omega[0]) ** 2
+    atol = np.concatenate([np.full(n, 1e-3 * rtol * scale), np.full(n, 1e-3 * rtol * scale * free.omega[0])])
+    t_grid = np.arange(int(round(T / dt)) + 1) * dt
+    segs = []
+    u = np.full(t_grid.size, np.nan)
+    y = np.zeros(2 * n)
+    t0, engaged = 0.0, False
+    events: list[tuple[float, str]] = []
+    breaks = [Td, T]
+    while t0 < T:
+        m = st[engaged]
+        t1 = next(b for b in breaks if b > t0)
+
+        def rhs(t, y, m=m):
+            e, d = y[:n], y[n:]
+            return np.concatenate([d, m["p"] * ug(t) + m["f0"] - m["c2"] * d - m["om2"] * e])
+
+        def opening(t, y, m=m):
+            return gap - s * float(m["Wa"] @ y[:n])
+
+        opening.terminal = True
+        opening.direction = 1.0 if engaged else -1.0
+        sol = solve_ivp(rhs, (t0, t1), y, method="DOP853", rtol=rtol, atol=atol,
+                        events=opening, dense_output=True)
+        te = float(sol.t_events[0][0]) if sol.status == 1 else float(sol.t[-1])
+        sel = (t_grid >= t0) & ((t_grid < te) | (te >= T))
+        if sel.any():
+            u[sel] = -s * (m["Wa"] @ sol.sol(t_grid[sel])[:n])  # u = -w above, +w below
+        segs.append((t0, te, sol.sol, m["Wa"]))
+        y = sol.sol(te)
+        t0 = te
+        if sol.status == 1:
+            events.append((te, "rebound" if engaged else "impact"))
+            engaged = not engaged
+            Pm = P[engaged]
+            y = np.concatenate([Pm @ y[:n], Pm @ y[n:]])
+    kmax = int(np.nanargmax(u))
+    # refine the maximum on the dense output (du/dt = 0 next to the best sample)
+    t_max, u_max = float(t_grid[kmax]), float(u[kmax])
+    t_lo, t_hi = t_grid[max(kmax - 1, 0)], t_grid[min(kmax + 1, t_grid.size - 1)]
+    for ta_, tb_, so, Wa in segs:
+        if ta_ <= t_lo and t_hi <= tb_:
+            du = lambda t: -s * float(Wa @ so(t)[n:])  # noqa: E731
+            for lo, hi in ((t_lo, t_max), (t_max, t_hi)):
+                if du(lo) > 0 > du(hi):
+                    tc = brentq(du, lo, hi, xtol=1e-14)
+                    uc = -s * float(Wa @ so(tc)[:n])
+                    if uc > u_max:
+                        t_max, u_max = tc, uc
+    imp = [t for t, kind in events if kind == "impact"]
+    reb = [t for t, kind in events if kind == "rebound"]
+    after = [(x, z) for x, z in zip(imp, reb) if x >= t_max]
+    return {
+        "max_response": u_max,
+        "t_max": t_max,
+        "first_impact_time": imp[0] if imp else None,
+        "contact_duration": (after[0][1] - after[0][0]) if after else None,
+        "n_impacts": len(imp),
+        "event_times": np.array([t for t, _ in events]),
+    }
+
+
+def _median_time(fn, repeats: int) -> tuple[float, object]:
+    out = fn()  # warm-up (mode sets cached, code paths compiled)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=30, help="timed runs of ib.simulate (default 30)")
+    ap.add_argument("--baseline-repeats", type=int, default=5, help="timed runs of the solve_ivp model (default 5)")
+    args = ap.parse_args()
+    sc = ib.load_scenario(CASE)
+    t_exact, res = _median_time(lambda: ib.simulate(sc), args.repeats)
+    t_metrics, m = _median_time(lambda: res.metrics(), args.repeats)
+    t_base, b = _median_time(lambda: baseline(sc), args.baseline_repeats)
+    # a tighter baseline as the accuracy reference for both
+    ref = baseline(sc, rtol=1e-11)
+    print(f"Case 3 ({CASE.name}): {sc.solver.modes} modes, step {sc.solver.time_step:g} s, end {sc.solver.end_time:g} s")
+    print("mode sets cached (ib.mode_set LRU); medians after one warm-up run")
+    print(f"  ib.simulate                 median {t_exact * 1e3:9.2f} ms  ({args.repeats} runs)")
+    print(f"  result.metrics()            median {t_metrics * 1e3:9.2f} ms")
+    print(f"  solve_ivp model (rtol 1e-8) median {t_base * 1e3:9.2f} ms  ({args.baseline_repeats} runs)")
+    print(f"  ratio solve_ivp / ib.simulate: {t_base / t_exact:8.1f}")
+    print("\nmetric                 ib.simulate          solve_ivp 1e-8       |exact - ref|  |ivp1e-8 - ref|  (ref: solve_ivp rtol 1e-11)")
+    for key in ("max_response", "t_max", "first_impact_time", "contact_duration", "n_impacts"):
+        va, vb, vr = m[key], b[key], ref[key]
+        print(f"{key:20s} {va!s:>20.14} {vb!s:>20.14} {abs(va - vr):14.3g} {abs(vb - vr):16.3g}")
+    ta = np.array([e.time for e in res.events])
+    if ta.size == b["event_times"].size == ref["event_times"].size:
+        print(f"event times: max |exact - ref| {np.abs(ta - ref['event_times']).max():.3g} s, "
+              f"max |ivp1e-8 - ref| {np.abs(b['event_times'] - ref['event_times']).max():.3g} s "
+              f"({ta.size} events)")
+    else:
+        print(f"event counts differ: exact {ta.size}, solve_ivp {b['event_times'].size}, ref {ref['event_times'].size}")
+
+
+if __name__ == "__main__":
+    main()
