@@ -183,8 +183,10 @@ class ClosedFormSegment:
             C = V @ C
         t = tau[None, :]
         ld = self.load
-        val = C[:, 0:1].real + C[:, 1:2].real * t
-        der = np.broadcast_to(C[:, 1:2].real, val.shape).copy()
+        c1 = C[:, 1:2].real
+        val = C[:, 0:1].real + c1 * t
+        der = np.empty_like(val)
+        der[...] = c1
         if np.any(C[:, 2]) or np.any(C[:, 3]):
             val = val + C[:, 2:3].real * t**2 + C[:, 3:4].real * t**3
             der = der + 2.0 * C[:, 2:3].real * t + 3.0 * C[:, 3:4].real * t**2

@@ -140,17 +140,18 @@ class _Integrator:
         n_p = points.size
         n_c = len(contactors)
         nm = options.modes
-        self.w = np.full((self.n_out, n_p), np.nan)
-        self.w_t = np.full((self.n_out, n_p), np.nan)
-        self.wc = np.full((self.n_out, n_c), np.nan)
-        self.wtc = np.full((self.n_out, n_c), np.nan)
+        # filled segment by segment; rows never reached (a run stopped early) become NaN at the end
+        self.w = np.empty((self.n_out, n_p))
+        self.w_t = np.empty((self.n_out, n_p))
+        self.wc = np.empty((self.n_out, n_c))
+        self.wtc = np.empty((self.n_out, n_c))
         self.code = np.full(self.n_out, -1, dtype=np.int16)
-        self.kin = np.full(self.n_out, np.nan)
-        self.strain = np.full(self.n_out, np.nan)
-        self.lpow = np.full(self.n_out, np.nan)
-        self.dpow = np.full(self.n_out, np.nan)
-        self.eta = np.full((self.n_out, nm), np.nan)
-        self.eta_t = np.full((self.n_out, nm), np.nan)
+        self.kin = np.empty(self.n_out)
+        self.strain = np.empty(self.n_out)
+        self.lpow = np.empty(self.n_out)
+        self.dpow = np.empty(self.n_out)
+        self.eta = np.empty((self.n_out, nm))
+        self.eta_t = np.empty((self.n_out, nm))
         self.keys: list[tuple[int, ...]] = []
         self.events: list[Event] = []
         self.segments: list[Segment] = []
@@ -289,6 +290,10 @@ class _Integrator:
                 k_piece += 1
         if self.projection_warning is not None:
             message = f"{message} Warning: {self.projection_warning}"
+        unset = self.code < 0
+        if unset.any():
+            for arr in (self.w, self.w_t, self.wc, self.wtc, self.kin, self.strain, self.lpow, self.dpow, self.eta, self.eta_t):
+                arr[unset] = np.nan
         return RawSolution(
             self.time, self.w, self.w_t, self.wc, self.wtc, self.code, self.keys, self.kin, self.strain,
             self.lpow, self.dpow, self.eta, self.eta_t, self.events, self.segments, self.space, status,
