@@ -243,6 +243,11 @@ class _Integrator:
                 return hi
         return float(brentq(h, lo, hi, xtol=tol, rtol=4 * np.finfo(float).eps, maxiter=200))
 
+    def _release_in_tension(self, st, seg, orient, c: int, lo: float, hi: float) -> float:
+        """Time of the largest tension of an engaged contactor whose gap never closed."""
+        f = seg.projector(-orient[c] * self.side[c] * st.W_contact[c], orient[c] * self.gap[c])
+        return float(brentq(lambda t: f(t)[1], lo, hi, xtol=self.opt.event_tolerance))
+
     # ------------------------------------------------------------------ main loop
     def _run_from(self, eta: np.ndarray, deta: np.ndarray) -> RawSolution:
         opt = self.opt
@@ -375,14 +380,21 @@ class _Integrator:
                 dtau = taus - tprev
                 graze = (Hprev > 0) & (H > 0) & (dHprev < 0) & (dH > 0)
                 graze &= (Hprev < np.abs(dHprev) * dtau) | (H < np.abs(dH) * dtau)
-                cand = (cross | graze) & (dtau > 0.0)  # tau = 0 may be both ends of the first interval
+                # an engaged contactor still in tension (the projection of eq. 12 left
+                # its gap open) is released where it starts to move away: a
+                # one-sided spring cannot pull
+                tension = (orient < 0)[:, None] & (Hprev <= 0.0) & (H < 0.0) & (dHprev > 0.0) & (dH <= 0.0)
+                cand = (cross | graze | tension) & (dtau > 0.0)  # tau = 0 may be both ends of the first interval
                 if cand.any():
                     for j in np.nonzero(cand.any(axis=0))[0]:
                         best = None
                         for c in np.nonzero(cand[:, j])[0]:
-                            r = self._locate(
-                                st, seg, orient, int(c), tprev[j], taus[j], Hprev[c, j], dHprev[c, j], dH[c, j]
-                            )
+                            if tension[c, j] and not cross[c, j]:
+                                r = self._release_in_tension(st, seg, orient, int(c), tprev[j], taus[j])
+                            else:
+                                r = self._locate(
+                                    st, seg, orient, int(c), tprev[j], taus[j], Hprev[c, j], dHprev[c, j], dH[c, j]
+                                )
                             if r is not None and (best is None or r < best[0]):
                                 best = (r, int(c))
                         if best is not None:

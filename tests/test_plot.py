@@ -1,0 +1,111 @@
+"""Tests of impactbeam.plot: handles, labels with units, atomic files, data drawn = data given."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import impactbeam as ib
+from impactbeam import paper, plot
+
+
+@pytest.fixture(scope="module")
+def case3():
+    return ib.simulate(paper.case(3).with_values({"solver.end_time": 0.06}))
+
+
+@pytest.fixture(scope="module")
+def case12():
+    return ib.simulate(paper.case(12).with_values({"solver.end_time": 0.05, "output.point_ratios": [0.484, 1.0]}))
+
+
+def test_plot_result_draws_the_solution(case3, tmp_path):
+    path = tmp_path / "r.png"
+    h = plot.plot_result(case3, path)
+    ax_w, ax_f = h.axes
+    x, y = h.lines[0].get_data()
+    np.testing.assert_array_equal(x, case3.time)
+    np.testing.assert_allclose(y, case3.w_contact[:, 0] * 1e3)  # mm
+    assert "[mm]" in ax_w.get_ylabel() and "[N]" in ax_f.get_ylabel() and "[s]" in ax_f.get_xlabel()
+    n_impacts = sum(e.kind == "impact" for e in case3.events)
+    assert len(h.artists["contact_spans"]) == n_impacts > 0
+    assert len(h.artists["impacts"].get_xdata()) == n_impacts
+    assert h.artists["surface"].get_ydata()[0] == pytest.approx(0.229)
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(path)
+    assert img.shape[0] > 100 and np.std(img[..., :3]) > 0.01
+    assert not list(tmp_path.glob(".*"))  # no temporary file left
+
+
+def test_plot_result_on_given_axes(case3):
+    fig, grid = plot._new_figure((4, 3))
+    h = plot.plot_result(case3, ax=grid[0, 0])
+    assert h.axes[0] is grid[0, 0] and len(h.axes) == 2  # twin axis for the force
+    assert h.figure is fig
+
+
+def test_plot_result_without_contactor(case12):
+    h = plot.plot_result(case12)
+    assert len(h.axes) == 1 and h.artists["contact_spans"] == []
+
+
+def test_surface_distance_is_gap_function(case3, case12):
+    c = case3.contactors[0]
+    np.testing.assert_allclose(plot.surface_distance(case3), c.gap - case3.w_contact[:, 0])
+    np.testing.assert_allclose(plot.surface_distance(case12), -case12.w[:, 0])
+    np.testing.assert_allclose(plot.surface_distance(case12, side="below"), case12.w[:, 0])
+
+
+def test_plot_response_dense_point(case12):
+    """A point that is not an output point is evaluated exactly; the tip equals the stored column."""
+    x_mid = 0.03
+    h = plot.plot_response(case12, quantity="w", x=x_mid)
+    _, y = h.lines[0].get_data()
+    np.testing.assert_allclose(y, case12.displacement([x_mid], case12.time)[0] * 1e3)
+    h2 = plot.plot_response([case12], quantity="w", x=0.1092, labels=["tip"])
+    np.testing.assert_allclose(h2.lines[0].get_data()[1], case12.w[:, 1] * 1e3)
+
+
+def test_plot_response_reference_and_errors(case3):
+    h = plot.plot_response([case3, case3], labels=["a", "b"], reference=[(1.0e-3, "ref")], time_window=(0.0, 0.02))
+    assert len(h.lines) == 2 and h.artists["reference"][0].get_ydata()[0] == pytest.approx(1.0)
+    assert h.lines[0].get_data()[0].max() <= 0.02
+    with pytest.raises(ib.ParameterError, match="labels"):
+        plot.plot_response([case3], labels=["a", "b"])
+    with pytest.raises(ib.ParameterError, match="quantity"):
+        plot.plot_response(case3, quantity="v")
+
+
+def test_plot_excitation_in_g():
+    ex = paper.case(3).excitation
+    h = plot.plot_excitation([ex], labels=["15 g"])
+    t, y = h.lines[0].get_data()
+    assert y.max() == pytest.approx(15.0, rel=1e-3)  # half-sine peak in g, sampled at 50 us
+    assert "[g]" in h.axes[0].get_ylabel()
+
+
+def test_plot_parameter_study_and_convergence(tmp_path):
+    h = plot.plot_parameter_study([1, 2, 3], {"a": [1.0, np.nan, 3.0], "b": [3, 2, 1]},
+                                  metric_labels={"a": "a [mm]"}, parameter_label="p [N/m]", baseline=2,
+                                  path=tmp_path / "s.png")
+    assert len(h.axes) == 2 and h.axes[0].get_ylabel() == "a [mm]"
+    assert len(h.lines[0].get_xdata()) == 2  # NaN left out
+    assert (tmp_path / "s.png").stat().st_size > 0
+    with pytest.raises(ib.ParameterError, match="metrics.a"):
+        plot.plot_parameter_study([1, 2], {"a": [1.0]})
+    h = plot.plot_convergence([2, 4, 8], {"x": [1.1, 1.01, 1.0]})
+    np.testing.assert_allclose(h.lines[0].get_ydata(), [10.0, 1.0])
+
+
+def test_save_figure_rejects_unknown_suffix(case3, tmp_path):
+    h = plot.plot_response(case3)
+    with pytest.raises(ib.ParameterError, match="unsupported"):
+        plot.save_figure(h.figure, tmp_path / "x.doc")
+    with pytest.raises(OSError):
+        plot.save_figure(h.figure, tmp_path / "missing" / "x.png")
+
+
+def test_result_plot_forwards(case3, tmp_path):
+    h = case3.plot(tmp_path / "f.png")
+    assert isinstance(h, plot.PlotHandles) and (tmp_path / "f.png").is_file()
