@@ -50,9 +50,7 @@ __all__ = [
     "__version__",
 ]
 
-try:  # the scenario layer
-    from .scenario import Scenario, load_scenario, parse_scenario  # noqa: F401
+from .scenario import Scenario, load_scenario, parse_scenario
+from .sweep import sweep
 
-    __all__ += ["Scenario", "load_scenario", "parse_scenario"]
-except ImportError:  # pragma: no cover - during development only
-    pass
+__all__ += ["Scenario", "load_scenario", "parse_scenario", "sweep"]
