@@ -156,6 +156,17 @@ class SimulationResult:
             out[:, sel] = W @ (eta if which == 0 else deta)
         return out
 
+    def _scalar(self, x: float, lo: float, hi: float):
+        """``(t0, f)`` with ``f(tau) -> (w(x), w_t(x))`` of the one segment covering [lo, hi], else None."""
+        segs = self._raw.segments
+        starts = np.array([s.t0 for s in segs])
+        j = int(np.clip(np.searchsorted(starts, lo, side="right") - 1, 0, len(segs) - 1))
+        seg = segs[j]
+        if not (seg.t0 <= lo and hi <= seg.t1) or not hasattr(seg.solution, "projector"):
+            return None
+        W = self._raw.space.state(seg.engaged).modes.shapes([x])[:, 0]
+        return seg.t0, seg.solution.projector(W)
+
     def displacement(self, x, t) -> np.ndarray:
         """Exact deflection ``w(x, t)`` [m] at any positions and times: array (n_x, n_t)."""
         return self._dense(x, t, 0)
