@@ -47,6 +47,7 @@ class ModalDynamics:
         object.__setattr__(self, "wh", np.sqrt(np.where(over, -disc, 0.0)))
         object.__setattr__(self, "rigid", om == 0.0)
         object.__setattr__(self, "all_under", bool(under.all()))
+        object.__setattr__(self, "mu", -a + 1j * np.sqrt(np.where(under, disc, 0.0)))
 
     decay: np.ndarray = None  # type: ignore[assignment]
     under: np.ndarray = None  # type: ignore[assignment]
@@ -55,6 +56,7 @@ class ModalDynamics:
     wh: np.ndarray = None  # type: ignore[assignment]
     rigid: np.ndarray = None  # type: ignore[assignment]
     all_under: bool = False
+    mu: np.ndarray = None  # type: ignore[assignment]
 
     def grid_table(self, h: float, n: int) -> np.ndarray:
         """``exp(mu_n h j)``, ``mu_n = -a_n + i w_dn``, j = 0..n-1 (under-damped modes; cached).
@@ -139,15 +141,15 @@ class ClosedFormSegment:
             self._res = res if res.any() else None
             safe = np.where(res | dyn.rigid, 1.0, den)
             self._Hc = np.where(dyn.rigid | res, 0.0, 1.0 / safe)
-        p0, dp0 = self._particular(np.zeros(1))
-        self.h0 = eta0 - p0[:, 0]
-        self.dh0 = deta0 - dp0[:, 0]
+        self._pcoef = None
+        p0, dp0 = self._particular_at(0.0)
+        self.h0 = eta0 - p0
+        self.dh0 = deta0 - dp0
         # under-damped homogeneous part: eta_h = Re(A E), eta_h' = Re(B E), E = exp(mu tau)
         wd = np.where(dyn.under, dyn.wd, 1.0)
         a = dyn.decay
         self._A = np.where(dyn.under, self.h0 - 1j * (a * self.h0 + self.dh0) / wd, 0.0)
         self._B = np.where(dyn.under, self.dh0 - 1j * (-(dyn.omega**2) * self.h0 - a * self.dh0) / wd, 0.0)
-        self._pcoef = None
 
     def _particular_coefficients(self) -> np.ndarray:
         """Per-mode coefficients of the particular solution on the basis
@@ -175,6 +177,33 @@ class ClosedFormSegment:
                 C[:, 6] = np.where(self._res, -ld.d / (2.0 * om), 0.0)
         self._pcoef = C
         return C
+
+    def _particular_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """Per-mode particular part and its derivative at one ``tau``."""
+        C = self._particular_coefficients()
+        c0, c1, c2, c3 = C[:, 0].real, C[:, 1].real, C[:, 2].real, C[:, 3].real
+        val = c0 + tau * (c1 + tau * (c2 + tau * c3))
+        der = c1 + tau * (2.0 * c2 + 3.0 * c3 * tau)
+        ld = self.load
+        if ld.d is not None:
+            W = ld.Omega
+            th = W * tau + ld.phi
+            z = complex(math.cos(th), math.sin(th))
+            cz = C[:, 4] * z
+            c5, c6 = C[:, 5].real, C[:, 6].real
+            val = val + cz.imag + c5 * z.imag + c6 * tau * z.real
+            der = der + W * cz.real + W * c5 * z.real + c6 * (z.real - W * tau * z.imag)
+        return val, der
+
+    def state_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """Modal displacement and velocity at one ``tau`` (shape (n,) each)."""
+        dyn = self.dyn
+        if not dyn.all_under:
+            e, d = self.evaluate(np.array([tau]))
+            return e[:, 0], d[:, 0]
+        E = np.exp(dyn.mu * tau)
+        P, dP = self._particular_at(tau)
+        return (self._A * E).real + P, (self._B * E).real + dP
 
     def _particular_grid(self, V: np.ndarray | None, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``V @ P(tau)`` and its derivative (V None: per mode)."""

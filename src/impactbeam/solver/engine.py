@@ -23,6 +23,7 @@ from scipy.optimize import brentq
 from ..beam import Beam, Contactor
 from ..loading import Excitation, InitialCondition, TimePiece, time_pieces
 from ..modes import mode_set
+from . import kernels
 from .closed_form import ClosedFormSegment, LoadForm
 from .options import Damping, SolverOptions
 from .states import StateModel, StateSpace
@@ -195,8 +196,14 @@ class _Integrator:
         """
         if not self.contactors:
             return None
-        e0, d0 = seg.evaluate(np.array([0.0, tau1]))
-        h, dh, _, _ = self._h(st, orient, e0, d0)
+        e0, d0 = seg.state_at(0.0)
+        h0, dh0, _, _ = self._h(st, orient, e0[:, None], d0[:, None])
+        if just is None and np.all(h0[:, 0] > self.tol_h):
+            return None  # every contactor clearly on its consistent side
+        e1, d1 = seg.state_at(tau1)
+        h1, dh1, _, _ = self._h(st, orient, e1[:, None], d1[:, None])
+        h = np.concatenate([h0, h1], axis=1)
+        dh = np.concatenate([dh0, dh1], axis=1)
         for c in range(len(self.contactors)):
             if c == just:
                 if dh[c, 0] * tau1 < -self.tol_h:
@@ -280,8 +287,7 @@ class _Integrator:
                     continue
             te, c_hit = self._advance(st, seg, orient, t, t_end)
             self.segments.append(Segment(t, te, engaged, seg, piece))
-            e1, d1 = seg.evaluate(np.array([te - t]))
-            eta, deta = e1[:, 0], d1[:, 0]
+            eta, deta = seg.state_at(te - t)
             t = te
             if self.progress is not None:
                 self.progress(t)
@@ -349,6 +355,14 @@ class _Integrator:
         k = math.ceil(t0 / h - 1e-9)
         k_last = math.floor(t_end / h + 1e-9)
         V = (orient * -self.side)[:, None] * st.W_contact  # h = orient (gap - s w) = orient*gap + V @ eta
+        if kernels.AVAILABLE and st.dyn.all_under:
+            ld = seg.load
+            tau, c = kernels.scan(
+                t0, h, k, k_last, t_end, st.dyn.mu, V * seg._A[None, :], V * seg._B[None, :],
+                orient * self.gap, V @ seg._particular_coefficients(), ld.Omega, ld.phi, ld.d is not None,
+                orient < 0, self.tol_h, self.opt.event_tolerance,
+            )
+            return (None, None) if c < 0 else (float(tau), int(c))
         base = (orient * self.gap)[:, None]
         hv, dv = seg.evaluate_grid(0.0, h, 1, V)
         hp, dhp = hv[:, 0] + base[:, 0], dv[:, 0]
@@ -412,6 +426,20 @@ class _Integrator:
         i0 = max(0, math.ceil(t0 / dt - 1e-9))
         i1 = self.n_out if t1 >= self.opt.end_time else min(self.n_out, math.ceil(t1 / dt - 1e-9))
         code = self._code(st.engaged)
+        if i1 <= i0:
+            return
+        if kernels.AVAILABLE and st.dyn.all_under:
+            ld = seg.load
+            n = st.modes.count
+            kernels.output(
+                t0, dt, i0, i1, st.dyn.mu, seg._A, seg._B, seg._particular_coefficients(), ld.Omega, ld.phi,
+                ld.d is not None, ld.a - st.gap_force, ld.b if ld.b is not None else np.zeros(n),
+                ld.d if ld.d is not None else np.zeros(n), st.modes.omega, 2.0 * st.dyn.decay, st.W_out,
+                st.W_contact, self.w, self.w_t, self.wc, self.wtc, self.kin, self.strain, self.lpow, self.dpow,
+                self.eta, self.eta_t,
+            )
+            self.code[i0:i1] = code
+            return
         om = st.modes.omega[:, None]
         damp2 = (2.0 * st.dyn.decay)[:, None]
         for a in range(i0, i1, 8192):

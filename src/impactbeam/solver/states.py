@@ -104,8 +104,8 @@ class StateSpace:
         xi = self.damping.ratios(bool(engaged), ms.count)
         dyn = ModalDynamics(ms.omega, xi)
         n = ms.count
-        Wc = ms.shapes(self.positions).T if self.contactors else np.zeros((0, n))
-        Wo = ms.shapes(self.points).T if self.points.size else np.zeros((0, n))
+        Wc = np.ascontiguousarray(ms.shapes(self.positions).T) if self.contactors else np.zeros((0, n))
+        Wo = np.ascontiguousarray(ms.shapes(self.points).T) if self.points.size else np.zeros((0, n))
         p = spatial_projection(self.excitation, ms.shapes, ms.integral(), self.beam.mass_per_length)
         gap_force = np.zeros(n)
         for i in engaged:
