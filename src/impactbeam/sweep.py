@@ -1192,6 +1192,16 @@ def run_sweep(
              spec.name, spec.n_cases, counts["computed"], skipped, counts["failed"])
     import xarray as xr
 
+    if out_path is not None:
+        import warnings
+
+        import zarr
+
+        # consolidated metadata lets xr.open_zarr(path) open the finished store without a
+        # warning; zarr 3 notes (ZarrUserWarning) that it is an extension of its format 3
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Consolidated metadata", category=UserWarning)
+            zarr.consolidate_metadata(store)
     ds = xr.open_zarr(store, consolidated=False, chunks=None)
     order = [*spec.metrics, "status", "message", *(["w"] if spec.histories is not None else [])]
     ds = ds[order]  # the store lists its arrays in no particular order
