@@ -8,7 +8,6 @@ and against the example files.
 
 from __future__ import annotations
 
-import math
 import re
 import shutil
 import subprocess

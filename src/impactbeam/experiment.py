@@ -1459,21 +1459,10 @@ class Comparison:
 
 
 def _save_figure(fig: Any, path: str | Path) -> None:
-    import os
-    import tempfile
+    from ._atomic import atomic_path
 
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent or ".")
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=130, bbox_inches="tight")
-        os.replace(tmp, target)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def _prepare(

@@ -37,12 +37,10 @@ References
 from __future__ import annotations
 
 import html
-import json
 import math
 import os
 import shutil
 import sys
-import tempfile
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -51,6 +49,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._atomic import atomic_path, write_text
 from .exceptions import ParameterError
 
 if TYPE_CHECKING:
@@ -771,27 +770,9 @@ def _inline_html(text: str) -> str:
     return s
 
 
-def _umask_mode(path: str) -> None:
-    """Give a mkstemp file (mode 0600) the usual 0666 & ~umask permissions."""
-    mask = os.umask(0)
-    os.umask(mask)
-    os.chmod(path, 0o666 & ~mask)
-
-
 def _write_text(path: Path, text: str) -> None:
     """Write atomically (temporary file in the same directory + os.replace)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-        _umask_mode(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    write_text(path, text)
 
 
 # =========================================================================== trends
@@ -1788,11 +1769,8 @@ def write_readme_section(report: ReproductionReport, docs_dir: str | os.PathLike
     (docs / "figures").mkdir(parents=True, exist_ok=True)
     for name in figures:
         src = report.figures[name]
-        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".png", dir=docs / "figures")
-        os.close(fd)
-        shutil.copyfile(src, tmp)
-        _umask_mode(tmp)
-        os.replace(tmp, docs / "figures" / f"{name}.png")
+        with atomic_path(docs / "figures" / f"{name}.png") as tmp:
+            shutil.copyfile(src, tmp)
     doc = _Doc()
     doc.h(2, "Reproducing the paper")
     doc.p("`make demo` runs `impactbeam reproduce --out out/paper`, which simulates every case of Table 1 of Xu & "

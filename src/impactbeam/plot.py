@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from ._atomic import atomic_path
 from .exceptions import ParameterError
 
 if TYPE_CHECKING:
@@ -98,21 +98,9 @@ def save_figure(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 110)
     suffix = p.suffix.lower()
     if suffix not in FIGURE_SUFFIXES:
         raise ParameterError(f'figure path: unsupported file type "{p.suffix or p.name}" (use {", ".join(FIGURE_SUFFIXES)})')
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=suffix, dir=p.parent if str(p.parent) else ".")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            meta = {"Software": None} if suffix == ".png" else None
-            figure.savefig(fh, format=suffix.lstrip("."), dpi=dpi, metadata=meta)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, p)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    with atomic_path(p) as tmp:
+        meta = {"Software": None} if suffix == ".png" else None
+        figure.savefig(tmp, format=suffix.lstrip("."), dpi=dpi, metadata=meta)
     return p
 
 

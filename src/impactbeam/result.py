@@ -5,13 +5,13 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._atomic import atomic_path
 from .beam import Beam, Contactor
 from .exceptions import ParameterError
 
@@ -287,9 +287,7 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     if suffix not in RESULT_SUFFIXES:
         raise ParameterError(f"--out: unsupported file type {suffix!r}; use one of {', '.join(RESULT_SUFFIXES)}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         if suffix == ".nc":
             ds = result.to_xarray()
             ds.attrs["metrics"] = metrics_json(result.metrics())
@@ -298,9 +296,4 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
             result.to_dataframe().to_csv(tmp, index=False)
         else:
             result.to_dataframe().to_parquet(tmp, index=False)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return path

@@ -29,7 +29,6 @@ import io
 import math
 import os
 import re
-import tempfile
 import tomllib
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
@@ -39,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from ._atomic import write_text
 from ._validation import choice, nonnegative_finite, positive_finite
 from .beam import SUPPORT_PRESETS, Beam, Contactor, Support
 from .exceptions import ParameterError, ScenarioError
@@ -413,20 +413,7 @@ def dump_scenario(data: Mapping[str, Any], path: str | os.PathLike[str]) -> None
         text = tomli_w.dumps(raw)
     except (TypeError, ValueError) as exc:
         raise ScenarioError(f"cannot write the scenario as TOML: {exc}") from None
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, target)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    write_text(path, text)
 
 
 # --------------------------------------------------------------------------- value helpers

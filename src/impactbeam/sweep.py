@@ -555,7 +555,7 @@ def _check_value(err: _Errors, base: Scenario, path: str, value: Any, label: str
         base.with_values({path: value})
     except ScenarioError as exc:
         msg = str(exc)
-        if msg.startswith(f'unknown key "{path}"') or msg.startswith(f'unknown table "{path}"') or msg.startswith(f"invalid path"):
+        if msg.startswith(f'unknown key "{path}"') or msg.startswith(f'unknown table "{path}"') or msg.startswith("invalid path"):
             raise err(f'parameters."{path}"', msg) from None
         raise err(f'parameters."{path}"', f"{label}: {msg}") from None
 
