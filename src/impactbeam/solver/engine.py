@@ -251,7 +251,7 @@ class _Integrator:
         return float(brentq(h, lo, hi, xtol=tol, rtol=4 * np.finfo(float).eps, maxiter=200))
 
     def _release_in_tension(self, st, seg, orient, c: int, lo: float, hi: float) -> float:
-        """Time of the largest tension of an engaged contactor whose gap never closed."""
+        """Where a contactor on the wrong side of its state turns back (largest tension or penetration)."""
         f = seg.projector(-orient[c] * self.side[c] * st.W_contact[c], orient[c] * self.gap[c])
         return float(brentq(lambda t: f(t)[1], lo, hi, xtol=self.opt.event_tolerance))
 
@@ -394,10 +394,11 @@ class _Integrator:
                 dtau = taus - tprev
                 graze = (Hprev > 0) & (H > 0) & (dHprev < 0) & (dH > 0)
                 graze &= (Hprev < np.abs(dHprev) * dtau) | (H < np.abs(dH) * dtau)
-                # an engaged contactor still in tension (the projection of eq. 12 left
-                # its gap open) is released where it starts to move away: a
-                # one-sided spring cannot pull
-                tension = (orient < 0)[:, None] & (Hprev <= 0.0) & (H < 0.0) & (dHprev > 0.0) & (dH <= 0.0)
+                # a contactor left on the wrong side of its state by the projection of
+                # eq. 12 (engaged but open: in tension; free but penetrated) switches
+                # where its opening turns back before reaching the right side: a
+                # one-sided spring cannot pull, and a free beam cannot pass the stop
+                tension = (Hprev <= 0.0) & (H < 0.0) & (dHprev > 0.0) & (dH <= 0.0)
                 cand = (cross | graze | tension) & (dtau > 0.0)  # tau = 0 may be both ends of the first interval
                 if cand.any():
                     for j in np.nonzero(cand.any(axis=0))[0]:

@@ -249,7 +249,7 @@ def scan(t0, h, k0, k_last, t_end, mu, VA, VB, base, PC, Om, phi, has_sin, engag
                 cross = H[c] <= 0.0 and (hp > 0.0 or (touch and dhp > 0.0))
                 graze = hp > 0.0 and H[c] > 0.0 and dhp < 0.0 and dH[c] > 0.0
                 graze = graze and (hp < abs(dhp) * dtau or H[c] < abs(dH[c]) * dtau)
-                tension = engaged[c] and hp <= 0.0 and H[c] < 0.0 and dhp > 0.0 and dH[c] <= 0.0
+                tension = hp <= 0.0 and H[c] < 0.0 and dhp > 0.0 and dH[c] <= 0.0
                 r = np.nan
                 if tension and not cross:
                     r = _brent(1, c, tprev, tau, xtol, 4.0 * 2.220446049250313e-16, mu, VA, VB, base, PC, Om, phi, has_sin)
