@@ -330,7 +330,8 @@ class _Integrator:
         w_before = st.W_contact @ eta
         eta, deta = P @ eta, P @ deta
         moved = np.abs(self.space.state(new).W_contact @ eta - w_before)
-        scale = np.maximum(self.gap, np.abs(w_before)) + 1e-300
+        # floor 1e-6 L: with zero gap the deflection at the event is round-off
+        scale = np.maximum(np.maximum(self.gap, np.abs(w_before)), 1e6 * self.tol_h)
         worst = int(np.argmax(moved / scale))
         if moved[worst] > 0.05 * scale[worst] and self.projection_warning is None:
             self.projection_warning = (
@@ -475,7 +476,16 @@ def integrate(
     points: np.ndarray,
     progress: Callable[[float], None] | None = None,
 ) -> RawSolution:
-    """Run the event-driven exact integration; see :func:`impactbeam.simulate`."""
+    """Run the event-driven exact integration; see :func:`impactbeam.simulate`.
+
+    Problems whose every state is under-damped (up to 3 contactors, no progress
+    callback) run in the compiled loop of :mod:`~impactbeam.solver.fast`, which is
+    tested to reproduce this Python loop; everything else runs here.
+    """
+    from . import fast
+
+    if fast.supported(beam, contactors, damping, excitation, options, points, progress):
+        return fast.integrate_fast(beam, contactors, damping, excitation, initial, options, points)
     integ = _Integrator(beam, contactors, damping, excitation, initial, options, points, progress)
     eta, deta = initial_coordinates(beam, initial, options.modes)
     return integ._run_from(eta, deta)
