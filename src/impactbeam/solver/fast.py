@@ -5,7 +5,7 @@ as :func:`impactbeam.solver.engine.integrate` (same events, samples, state
 codes, energies, status and message, to round-off) but runs the whole event
 loop of paper section 2 (closed-form segments, eq. 10; event location; the
 projection of eqs. 11-12) in one numba function,
-:func:`~impactbeam.solver.fast_kernels.run`. :func:`supported` tells when it
+:func:`~impactbeam.solver.kernels.run`. :func:`supported` tells when it
 applies: numba is available, at most three contactors, every state (all
 ``2**n_contactors`` of them) has only under-damped modes (no rigid-body,
 critically or over-damped mode) and no progress callback is requested.
@@ -29,7 +29,7 @@ import numpy as np
 
 from ..beam import Beam, Contactor
 from ..loading import Excitation, InitialCondition, time_pieces
-from . import fast_kernels, kernels
+from . import kernels
 from .engine import Event, RawSolution, Segment, _segment, initial_coordinates
 from .options import Damping, SolverOptions
 from .states import StateModel, StateSpace
@@ -42,7 +42,7 @@ _CACHE_SIZE = 64
 
 
 class _Packed:
-    """The states of one problem packed into arrays for :func:`fast_kernels.run`."""
+    """The states of one problem packed into arrays for :func:`kernels.run`."""
 
     def __init__(self, space: StateSpace, states: dict[tuple[int, ...], StateModel], projection: str) -> None:
         nc = len(space.contactors)
@@ -89,7 +89,7 @@ class _Packed:
         tab = self.tables.get((h, dt))
         if tab is None:
             S, nm = self.om.shape
-            shape = (S, nm, fast_kernels.BLOCK)
+            shape = (S, nm, kernels.BLOCK)
             tab = (np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), np.zeros(S, dtype=np.bool_))
             if len(self.tables) >= 8:
                 self.tables.pop(next(iter(self.tables)))
@@ -272,7 +272,7 @@ def integrate_fast(
     code = np.full(n_out, -1, dtype=np.int16)
     Rs_r, Rs_i, Ro_r, Ro_i, built = pk.grid_tables(h, dt)
     (status, t_stop, nseg, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, nev, ev_t, ev_kind, ev_c, ev_v,
-     njump, jumps, nkeys, key_order, warn, warn_t, warn_c, warn_moved, warn_scale) = fast_kernels.run(
+     njump, jumps, nkeys, key_order, warn, warn_t, warn_c, warn_moved, warn_scale) = kernels.run(
         pk.om, pk.xi, pk.dec, pk.wd, pk.mu, pk.Wc, pk.Wo, pk.pw, pk.gf, pk.Tm, pk.gap, pk.side, pk.kst,
         pt0, pt1, pconst, pslope, pamp, pOm, pphase,
         float(T), float(dt), float(h), int(n_out), float(1e-12 * beam.length), float(options.event_tolerance),
