@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from ._textdata import read_data_lines
 from .exceptions import ParameterError, ScenarioError, SimulationError
 
 if TYPE_CHECKING:
@@ -330,19 +331,11 @@ def _read_text(
     def fail(detail: str) -> ScenarioError:
         return ScenarioError(f"{label}: {detail}", key="record")
 
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise fail("is not a text (UTF-8) file; use .csv or .nc") from None
-    except OSError as exc:
-        raise fail(f"cannot be read: {exc.strerror or exc}") from None
-    lines = [
-        (n, line) for n, line in enumerate(text.splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
+    lines, delimiter = read_data_lines(
+        p, fail, not_found=None, not_text="is not a text (UTF-8) file; use .csv or .nc"
+    )
     if not lines:
         raise fail("holds no data")
-    delimiter = next((d for d in (",", ";", "\t") if any(d in line for _, line in lines)), None)
 
     def cells(line: str) -> list[str]:
         if delimiter is None:

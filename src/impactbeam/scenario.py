@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from ._atomic import write_text
+from ._textdata import read_data_lines
 from ._validation import choice, nonnegative_finite, positive_finite
 from .beam import SUPPORT_PRESETS, Beam, Contactor, Support
 from .exceptions import ParameterError, ScenarioError
@@ -968,23 +969,8 @@ def read_table(
     def fail(detail: str) -> ScenarioError:
         return ScenarioError(f'{key}: "{name}" {detail}', key=key)
 
-    try:
-        text = Path(path).read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        where = "" if str(path) == name else f" (looked for {path})"
-        raise fail(f"not found{where}") from None
-    except IsADirectoryError:
-        raise fail("is a directory, not a CSV file") from None
-    except UnicodeDecodeError:
-        raise fail("is not a text (UTF-8) file") from None
-    except OSError as exc:
-        raise fail(f"cannot be read: {exc.strerror or exc}") from None
-
-    lines = [
-        (n, line) for n, line in enumerate(text.splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    delimiter = next((d for d in (",", ";", "\t") if any(d in line for _, line in lines)), None)
+    where = "" if str(path) == name else f" (looked for {path})"
+    lines, delimiter = read_data_lines(path, fail, not_found=f"not found{where}")
 
     def cells(line: str) -> list[str]:
         if delimiter is None:

@@ -52,24 +52,12 @@ _RESYNC = 128
 @njit(cache=True)
 def _part(C, i, tau, Om, phi, has_sin):  # pragma: no cover - compiled
     """Particular part (row ``i`` of C) and its derivative at ``tau``."""
-    c0 = C[i, 0].real
-    c1 = C[i, 1].real
-    c2 = C[i, 2].real
-    c3 = C[i, 3].real
-    val = c0 + tau * (c1 + tau * (c2 + tau * c3))
-    der = c1 + tau * (2.0 * c2 + 3.0 * c3 * tau)
+    zr = 0.0
+    zi = 0.0
     if has_sin:
-        th = Om * tau + phi
-        zr = math.cos(th)
-        zi = math.sin(th)
-        c4 = C[i, 4]
-        czr = c4.real * zr - c4.imag * zi
-        czi = c4.real * zi + c4.imag * zr
-        c5 = C[i, 5].real
-        c6 = C[i, 6].real
-        val += czi + c5 * zi + c6 * tau * zr
-        der += Om * czr + Om * c5 * zr + c6 * (zr - Om * tau * zi)
-    return val, der
+        zr = math.cos(Om * tau + phi)
+        zi = math.sin(Om * tau + phi)
+    return _part_z(C, i, tau, Om, zr, zi, has_sin)
 
 
 @njit(cache=True)
@@ -432,15 +420,7 @@ def _setup(om, xi, dec, wd, pw, gf, const, slope, amp, Om_piece, phase, tau, eta
         fb[n] = b_n
         fd[n] = d_n
         # particular part at tau = 0 (ClosedFormSegment._particular_at)
-        p0 = c0
-        dp0 = c1
-        if has_sin:
-            zr = math.cos(phi)
-            zi = math.sin(phi)
-            czr = c4.real * zr - c4.imag * zi
-            czi = c4.real * zi + c4.imag * zr
-            p0 = p0 + czi + 0.0 * zi + c6 * 0.0 * zr
-            dp0 = dp0 + Om * czr + Om * 0.0 * zr + c6 * (zr - Om * 0.0 * zi)
+        p0, dp0 = _part(C, n, 0.0, Om, phi, has_sin)
         h0 = eta0[n] - p0
         dh0 = deta0[n] - dp0
         a = dec[n]
@@ -460,20 +440,7 @@ def _state_at(tau, mu, A, B, C, has_sin, Om, phi, e, d):  # pragma: no cover - c
         zi = math.sin(th)
     for n in range(mu.size):
         E = np.exp(mu[n] * tau)
-        c0 = C[n, 0].real
-        c1 = C[n, 1].real
-        c2 = C[n, 2].real
-        c3 = C[n, 3].real
-        val = c0 + tau * (c1 + tau * (c2 + tau * c3))
-        der = c1 + tau * (2.0 * c2 + 3.0 * c3 * tau)
-        if has_sin:
-            c4 = C[n, 4]
-            czr = c4.real * zr - c4.imag * zi
-            czi = c4.real * zi + c4.imag * zr
-            c5 = C[n, 5].real
-            c6 = C[n, 6].real
-            val = val + czi + c5 * zi + c6 * tau * zr
-            der = der + Om * czr + Om * c5 * zr + c6 * (zr - Om * tau * zi)
+        val, der = _part_z(C, n, tau, Om, zr, zi, has_sin)
         e[n] = (A[n] * E).real + val
         d[n] = (B[n] * E).real + der
 
