@@ -1,4 +1,4 @@
-"""The closed-form modal propagator (solver/closed_form.py) against independent references.
+"""The compiled closed-form modal propagator (solver/_closed.py) against independent references.
 
 Each mode obeys (paper eq. 9, generalised)
 
@@ -24,7 +24,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from impactbeam.solver.closed_form import ClosedFormSegment, LoadForm, ModalDynamics
+from impactbeam.solver import _closed
+from impactbeam.solver.states import ModalDynamics
 
 REL_TOL = 1e-9
 
@@ -67,18 +68,36 @@ def _reference(omega, xi, load, eta0, deta0, taus):
     return sol.y[0], sol.y[1]
 
 
-def _closed(omegas, xis, load, eta0, deta0, taus):
-    n = len(omegas)
-    a, b, d, Om, phi = load
-    lf = LoadForm(
-        np.full(n, a),
-        None if b is None else np.full(n, b),
-        None if d is None else np.full(n, d),
-        Om,
-        phi,
-    )
-    seg = ClosedFormSegment(ModalDynamics(np.asarray(omegas, float), np.asarray(xis, float)), lf,
-                            np.asarray(eta0, float), np.asarray(deta0, float))
+class _Segment:
+    """One segment of the compiled closed form (setup once, evaluate anywhere)."""
+
+    def __init__(self, omegas, xis, load, eta0, deta0):
+        dyn = ModalDynamics(np.asarray(omegas, float), np.asarray(xis, float))
+        n = len(omegas)
+        a, b, d, Om, phi = load
+        self.reg = np.where(dyn.under, 0, np.where(dyn.over, 2, 1)).astype(np.int64)
+        self.a = dyn.decay
+        self.w = np.where(dyn.under, dyn.wd, dyn.wh)
+        self.om = dyn.omega
+        self.load = (np.full(n, a), np.full(n, b or 0.0), np.full(n, d or 0.0))
+        self.Om, self.phi = Om, phi
+        self.eta0, self.deta0 = np.asarray(eta0, float), np.asarray(deta0, float)
+        self.h0, self.dh0, self.P = np.empty(n), np.empty(n), np.empty((n, 7))
+        _closed.setup(self.reg, self.a, self.om, *self.load, Om, phi, self.eta0, self.deta0, self.h0, self.dh0, self.P)
+
+    def evaluate(self, taus):
+        n = self.om.size
+        eta, deta = np.empty((n, len(taus))), np.empty((n, len(taus)))
+        e, d = np.empty(n), np.empty(n)
+        for k, tau in enumerate(taus):
+            _closed.state_at(float(tau), self.reg, self.a, self.w, self.om, self.h0, self.dh0, self.P, self.Om,
+                             self.phi, e, d)
+            eta[:, k], deta[:, k] = e, d
+        return eta, deta
+
+
+def _evaluate(omegas, xis, load, eta0, deta0, taus):
+    seg = _Segment(omegas, xis, load, eta0, deta0)
     return seg.evaluate(taus), seg
 
 
@@ -90,7 +109,7 @@ def test_every_regime_matches_solve_ivp(load_name):
     xis = [r[1] for r in REGIMES]
     eta0 = np.linspace(-0.7, 0.9, len(REGIMES))
     deta0 = np.linspace(1.1, -0.4, len(REGIMES))
-    (eta, deta), _ = _closed(omegas, xis, load, eta0, deta0, taus)
+    (eta, deta), _ = _evaluate(omegas, xis, load, eta0, deta0, taus)
     for i, (om, xi) in enumerate(REGIMES):
         ref_e, ref_d = _reference(om, xi, load, eta0[i], deta0[i], taus)
         se = np.abs(ref_e).max()
@@ -103,7 +122,7 @@ def test_every_regime_matches_solve_ivp(load_name):
 def test_start_values_reproduced_exactly(xi):
     # At tau = 0 the closed form must return its initial state up to round-off
     # of the particular part subtracted and added back (a few ulp).
-    (eta, deta), _ = _closed([7.0, 0.0], [xi, xi], LOADS["all"], [0.3, -0.2], [-1.0, 0.5], np.zeros(1))
+    (eta, deta), _ = _evaluate([7.0, 0.0], [xi, xi], LOADS["all"], [0.3, -0.2], [-1.0, 0.5], np.zeros(1))
     np.testing.assert_allclose(eta[:, 0], [0.3, -0.2], rtol=0, atol=1e-15)
     np.testing.assert_allclose(deta[:, 0], [-1.0, 0.5], rtol=0, atol=1e-15)
 
@@ -113,7 +132,7 @@ def test_exact_resonance_undamped():
     # the textbook secular solution. Relative 1e-12: only round-off separates them.
     w, d = 7.0, 2.0
     taus = np.linspace(0.0, 10.0, 501)
-    (eta, deta), _ = _closed([w], [0.0], (0.0, None, d, w, 0.0), [0.0], [0.0], taus)
+    (eta, deta), _ = _evaluate([w], [0.0], (0.0, None, d, w, 0.0), [0.0], [0.0], taus)
     exact = d / (2 * w**2) * (np.sin(w * taus) - w * taus * np.cos(w * taus))
     dexact = d / 2 * taus * np.sin(w * taus)
     assert np.abs(eta[0] - exact).max() <= 1e-12 * np.abs(exact).max()
@@ -125,7 +144,7 @@ def test_exact_resonance_undamped():
 def test_resonance_against_solve_ivp_with_phase():
     load = (0.2, None, 1.0, 7.0, 0.4)
     taus = np.linspace(0.0, 4.0, 201)
-    (eta, deta), _ = _closed([7.0], [0.0], load, [0.1], [-0.3], taus)
+    (eta, deta), _ = _evaluate([7.0], [0.0], load, [0.1], [-0.3], taus)
     ref_e, ref_d = _reference(7.0, 0.0, load, 0.1, -0.3, taus)
     assert np.abs(eta[0] - ref_e).max() <= REL_TOL * np.abs(ref_e).max()
     assert np.abs(deta[0] - ref_d).max() <= REL_TOL * np.abs(ref_d).max()
@@ -135,7 +154,7 @@ def test_rigid_body_mode_polynomials():
     # omega = 0: eta = eta0 + v0 t + a t^2/2 + b t^3/6 + d (phi-terms) exactly.
     a, b, d, Om, phi = 0.7, -0.2, 0.5, 3.0, 0.3
     taus = np.linspace(0.0, 5.0, 101)
-    (eta, deta), _ = _closed([0.0], [0.0], (a, b, d, Om, phi), [0.4], [-0.1], taus)
+    (eta, deta), _ = _evaluate([0.0], [0.0], (a, b, d, Om, phi), [0.4], [-0.1], taus)
     # sine part: particular -d sin(Om t + phi)/Om^2, plus the homogeneous line fixing the start
     s = lambda t: -d * np.sin(Om * t + phi) / Om**2  # noqa: E731
     ds = lambda t: -d * np.cos(Om * t + phi) / Om  # noqa: E731
@@ -153,7 +172,7 @@ def test_static_limit_and_no_overflow(xi):
     # The fast root's exponential e^{-(a + w_h) tau} must not overflow or give NaN.
     w = 1e4
     taus = np.array([0.0, 1e-3, 0.05, 10.0, 1e4])
-    (eta, deta), _ = _closed([w], [xi], (3.0, None, None, 0.0, 0.0), [1e-4], [2.0], taus)
+    (eta, deta), _ = _evaluate([w], [xi], (3.0, None, None, 0.0, 0.0), [1e-4], [2.0], taus)
     assert np.all(np.isfinite(eta)) and np.all(np.isfinite(deta))
     if xi >= 0.9999:
         assert eta[0, 2] == pytest.approx(3.0 / w**2, rel=1e-12)
@@ -168,22 +187,58 @@ def test_near_critical_is_continuous_across_xi_equals_one():
     taus = np.linspace(0.0, 3.0, 61)
     outs = []
     for xi in (1 - 1e-7, 1.0, 1 + 1e-7):
-        (eta, _), _ = _closed([7.0], [xi], LOADS["all"], [0.5], [-0.8], taus)
+        (eta, _), _ = _evaluate([7.0], [xi], LOADS["all"], [0.5], [-0.8], taus)
         outs.append(eta[0])
     amp = np.abs(outs[1]).max()
     assert np.abs(outs[0] - outs[1]).max() < 1e-6 * amp
     assert np.abs(outs[2] - outs[1]).max() < 1e-6 * amp
 
 
-def test_force_and_acceleration_are_the_equation_of_motion():
-    # acceleration() must equal the derivative of the velocity; check by a
-    # central difference (h = 1e-5: truncation ~h^2 eta''' ~ 1e-8 of scale).
-    _, seg = _closed([7.0, 0.0], [0.05, 0.0], LOADS["all"], [0.3, 0.1], [0.2, -0.4], np.zeros(1))
-    h = 1e-5
-    for tau in (0.3, 1.7):
-        _, dp = seg.evaluate(np.array([tau + h]))
-        _, dm = seg.evaluate(np.array([tau - h]))
-        fd = (dp[:, 0] - dm[:, 0]) / (2 * h)
-        np.testing.assert_allclose(seg.acceleration(tau), fd, rtol=1e-7, atol=1e-8)
-    a, b, d, Om, phi = LOADS["all"]
-    np.testing.assert_allclose(seg.force(np.array([0.9]))[:, 0], a + b * 0.9 + d * math.sin(Om * 0.9 + phi))
+def test_derivatives_are_those_of_the_closed_form():
+    # _closed.derivatives gives d^k/dtau^k (v . eta) at 0 from the equation of
+    # motion; compare orders 1-3 with central differences of the closed form
+    # (h = 1e-3: truncation ~h^2 of the next derivative, ~1e-6 relative here).
+    seg = _Segment([7.0, 0.0, 3.0], [0.05, 0.0, 1.5], LOADS["all"], [0.3, 0.1, -0.2], [0.2, -0.4, 0.6])
+    v = np.array([0.7, -1.1, 0.4])
+    out, mag = np.empty(4), np.empty(4)
+    _closed.derivatives(v, 0.25, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, seg.Om, seg.phi, 3, out, mag)
+    h = 1e-3
+    taus = np.array([0.0, h, 2 * h, 3 * h, 4 * h])
+    eta, deta = seg.evaluate(taus)
+    g = 0.25 + v @ eta
+    dg = v @ deta
+    assert out[0] == pytest.approx(g[0], abs=1e-15)
+    assert out[1] == pytest.approx(dg[0], abs=1e-15)
+    # one-sided 4th-order differences of the velocity for orders 2 and 3
+    d2 = (-25 * dg[0] + 48 * dg[1] - 36 * dg[2] + 16 * dg[3] - 3 * dg[4]) / (12 * h)
+    d3 = (35 * dg[0] - 104 * dg[1] + 114 * dg[2] - 56 * dg[3] + 11 * dg[4]) / (12 * h * h)
+    assert out[2] == pytest.approx(d2, rel=1e-6)
+    assert out[3] == pytest.approx(d3, rel=1e-3)
+    assert np.all(mag >= np.abs(out) * (1 - 1e-12))
+
+
+@pytest.mark.parametrize("load_name", list(LOADS))
+def test_integral_in_closed_form_matches_quadrature(load_name):
+    # _closed.integral_of: int_0^T v . eta dtau; Gauss-Legendre with 200 points
+    # per unit time integrates these smooth functions to ~1e-14 relative.
+    seg = _Segment([o for o, _ in REGIMES], [x for _, x in REGIMES], LOADS[load_name],
+                   np.linspace(-0.7, 0.9, len(REGIMES)), np.linspace(1.1, -0.4, len(REGIMES)))
+    v = np.linspace(0.5, -1.5, len(REGIMES))
+    T = 2.3
+    exact = _closed.integral_of(v, seg.reg, seg.a, seg.w, seg.om, seg.h0, seg.dh0, seg.P, seg.Om, seg.phi, T)
+    x, w = np.polynomial.legendre.leggauss(460)
+    taus = 0.5 * T * (x + 1)
+    eta, _ = seg.evaluate(taus)
+    quad = 0.5 * T * float((v @ eta) @ w)
+    assert exact == pytest.approx(quad, rel=1e-12, abs=1e-13)
+
+
+def test_exact_resonance_integral():
+    # the resonant tau cos(theta) term has its own antiderivative
+    seg = _Segment([7.0], [0.0], (0.0, None, 2.0, 7.0, 0.3), [0.1], [0.0])
+    T = 3.0
+    exact = _closed.integral_of(np.ones(1), seg.reg, seg.a, seg.w, seg.om, seg.h0, seg.dh0, seg.P, seg.Om,
+                                seg.phi, T)
+    x, w = np.polynomial.legendre.leggauss(400)
+    eta, _ = seg.evaluate(0.5 * T * (x + 1))
+    assert exact == pytest.approx(0.5 * T * float(eta[0] @ w), rel=1e-12)

@@ -1,7 +1,8 @@
-"""SimulationResult: sampled histories, exact dense output, events, energy account."""
+"""SimulationResult: the exact solution, its events, and sampled histories on request."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -13,24 +14,58 @@ import numpy as np
 
 from ._atomic import atomic_path
 from .beam import Beam, Contactor
-from .exceptions import ParameterError
+from .exceptions import ParameterError, ResourceError
 
 if TYPE_CHECKING:
     import xarray as xr
 
-    from .solver.engine import Event, RawSolution
+    from .solver.solution import Event, PiecewiseSolution
 
-__all__ = ["SimulationResult", "write_result", "RESULT_SUFFIXES"]
+__all__ = ["SimulationResult", "write_result", "RESULT_SUFFIXES", "memory_limit", "check_memory"]
 
 RESULT_SUFFIXES = (".nc", ".csv", ".parquet")
+_CHUNK = 65536  # samples evaluated per call of the compiled sampler
+
+
+def memory_limit() -> int:
+    """Bytes a result may allocate for sampled histories (default 4 GiB).
+
+    Set the environment variable ``IMPACTBEAM_MEMORY_LIMIT`` (bytes, or a
+    number with ``K``, ``M``, ``G`` suffix) to change it.
+    """
+    raw = os.environ.get("IMPACTBEAM_MEMORY_LIMIT", "").strip().upper()
+    if not raw:
+        return 4 << 30
+    mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
+    try:
+        return int(float(raw.rstrip("KMGB") or "nan") * mult)
+    except ValueError:
+        raise ParameterError(f"IMPACTBEAM_MEMORY_LIMIT: not a size: {raw!r}") from None
+
+
+def check_memory(nbytes: float, what: str, hint: str) -> None:
+    """Raise ResourceError before allocating more than :func:`memory_limit`."""
+    limit = memory_limit()
+    if nbytes > limit:
+        raise ResourceError(
+            f"{what} would need {nbytes / 2**30:.3g} GiB, above the limit of {limit / 2**30:.3g} GiB; {hint} "
+            "(or raise IMPACTBEAM_MEMORY_LIMIT)"
+        )
 
 
 @dataclass(frozen=True, eq=False)
 class SimulationResult:
     """Result of :func:`impactbeam.simulate`.
 
+    The result holds the exact piecewise solution (``solution``); sampled
+    histories are evaluated on first access, at the output times
+    ``0, dt, 2 dt, ...`` (``solver.time_step``), and the metrics come from the
+    exact solution, not from the samples.
+
     Attributes
     ----------
+    solution : PiecewiseSolution
+        Dense output: evaluate anywhere with :meth:`displacement` / :meth:`velocity`.
     time : ndarray, (n_t,), [s]
         Output times (multiples of ``solver.time_step``).
     points : ndarray, (n_p,), [m]
@@ -47,140 +82,196 @@ class SimulationResult:
         Every impact and rebound at its exact time.
     energy : dict of ndarray (n_t,), [J]
         ``kinetic``, ``strain`` (beam and end supports), ``contactor``,
-        ``input_work`` and ``dissipated`` (cumulative), ``total``
-        (kinetic + strain + contactor) and ``residual``
-        (``total(0) + input_work - dissipated - total``: zero for the exact
-        N-mode model except for the projections at events and the trapezoid
-        rule of the cumulative integrals).
+        ``input_work`` and ``dissipated`` (cumulative, trapezoid rule on the
+        samples), ``total`` and ``residual``
+        (``total(0) + input_work - dissipated - total``).
     eta, eta_t : ndarray, (n_t, n_modes)
         Modal coordinates in the basis of the state at each sample.
     status : int
-        0 reached end_time; 1 stopped by the chattering guard.
+        0 reached end_time; 1 stopped by the chattering guard (later samples NaN).
     message : str
+    warnings : tuple of str
+        What the solver is not sure of (also issued as ImpactBeamWarning).
     """
 
-    time: np.ndarray
+    solution: PiecewiseSolution = field(repr=False)
     points: np.ndarray
-    w: np.ndarray
-    w_t: np.ndarray
-    w_contact: np.ndarray
-    w_t_contact: np.ndarray
-    contact_force: np.ndarray
-    engaged: np.ndarray
-    events: list[Event]
-    energy: dict[str, np.ndarray]
-    eta: np.ndarray
-    eta_t: np.ndarray
-    status: int
-    message: str
-    beam: Beam
+    beam: Beam = field(repr=False)
     contactors: tuple[Contactor, ...]
     n_modes: int
-    energy_jumps: np.ndarray = field(repr=False)
-    _raw: RawSolution = field(repr=False)
+    time_step: float
+    end_time: float
     scenario_name: str = "scenario"
     options: dict[str, Any] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ from the solution
+    @property
+    def events(self) -> list[Event]:
+        return self.solution.events
+
+    @property
+    def status(self) -> int:
+        return self.solution.status
+
+    @property
+    def message(self) -> str:
+        return self.solution.message
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        return tuple(self.solution.warnings)
+
+    @property
+    def energy_jumps(self) -> np.ndarray:
+        """Change of mechanical energy at each switch [J] (zero for a lossless change of basis)."""
+        return np.asarray(self.solution.energy_jumps)
 
     @property
     def success(self) -> bool:
         """True when the run reached its end time."""
         return self.status == 0
 
-    @classmethod
-    def from_raw(cls, raw: RawSolution, beam: Beam, contactors, points, n_modes: int, name: str, options: dict) -> SimulationResult:
-        n_t = raw.time.size
-        n_c = len(contactors)
-        engaged = np.zeros((n_t, n_c), dtype=bool)
-        codes = raw.state_code
-        for code, key in enumerate(raw.state_keys):
-            rows = codes == code
-            for c in key:
-                engaged[rows, c] = True
-        force = np.zeros((n_t, n_c))
-        contactor_energy = np.zeros(n_t)
-        spring_at_zero_gap = np.zeros(n_t)
-        for i, c in enumerate(contactors):
-            g = c.gap - c.direction * raw.w_contact[:, i]
-            comp = np.where(engaged[:, i], np.maximum(-g, 0.0), 0.0)
-            force[:, i] = c.stiffness * comp
-            contactor_energy += np.where(engaged[:, i], 0.5 * c.stiffness * g**2, 0.0)
-            spring_at_zero_gap += np.where(engaged[:, i], 0.5 * c.stiffness * raw.w_contact[:, i] ** 2, 0.0)
-        invalid = codes < 0
-        force[invalid] = np.nan
-        kinetic = raw.kinetic
-        strain = raw.modal_strain - spring_at_zero_gap
-        total = kinetic + strain + contactor_energy
-        dt = np.diff(raw.time)
-        cum = lambda p: np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * dt)])  # noqa: E731
-        input_work = cum(np.nan_to_num(raw.load_power))
-        dissipated = cum(np.nan_to_num(raw.damping_power))
-        residual = total[0] + input_work - dissipated - total
-        for arr in (input_work, dissipated, residual):
-            arr[invalid] = np.nan
-        energy = {
-            "kinetic": kinetic,
-            "strain": strain,
-            "contactor": np.where(invalid, np.nan, contactor_energy),
-            "input_work": input_work,
-            "dissipated": dissipated,
-            "total": total,
-            "residual": residual,
-        }
-        return cls(
-            raw.time, np.asarray(points, dtype=float), raw.w, raw.w_t, raw.w_contact, raw.w_t_contact, force,
-            engaged, list(raw.events), energy, raw.eta, raw.eta_t, raw.status, raw.message, beam,
-            tuple(contactors), n_modes, np.asarray(raw.switch_energy_jumps), raw, name, options,
-        )
+    # ------------------------------------------------------------------ sampled histories (lazy)
+    @functools.cached_property
+    def time(self) -> np.ndarray:
+        n = int(math.floor(self.end_time / self.time_step * (1.0 + 1e-12))) + 1
+        return np.arange(n) * self.time_step
 
-    # ------------------------------------------------------------------ dense output
-    def _dense(self, x, t, which: int) -> np.ndarray:
-        x = np.atleast_1d(np.asarray(x, dtype=float))
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        segs = self._raw.segments
-        starts = np.array([s.t0 for s in segs])
-        idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(segs) - 1)
-        out = np.full((x.size, t.size), np.nan)
-        space = self._raw.space
-        cache = self.__dict__.setdefault("_shape_cache", {})
-        xkey = x.tobytes()
-        for j in np.unique(idx):
-            seg = segs[j]
-            sel = (idx == j) & (t <= seg.t1 + 1e-15)
-            if not sel.any():
-                continue
-            W = cache.get((seg.engaged, xkey))
-            if W is None:
-                W = space.state(seg.engaged).modes.shapes(x).T
-                cache[(seg.engaged, xkey)] = W
-            eta, deta = seg.solution.evaluate(t[sel] - seg.t0)
-            out[:, sel] = W @ (eta if which == 0 else deta)
+    def _sampled(self, modal: bool) -> dict[str, np.ndarray]:
+        t = self.time
+        xs = np.concatenate([self.points, [c.position for c in self.contactors]])
+        nm = self.n_modes
+        per = 8 * (2 * xs.size + len(self.contactors) + (2 * nm + 4 if modal else 0))
+        check_memory(
+            per * t.size, f"sampling {t.size} output times ({'modal coordinates, ' if modal else ''}"
+            f"{xs.size} points)", "use a larger solver.time_step, fewer output points or a shorter end_time",
+        )
+        out = {
+            "w": np.empty((t.size, xs.size)), "w_t": np.empty((t.size, xs.size)),
+            "engaged": np.empty((t.size, len(self.contactors)), dtype=bool),
+        }
+        if modal:
+            out.update(eta=np.empty((t.size, nm)), eta_t=np.empty((t.size, nm)), energies=np.empty((t.size, 4)))
+        for a in range(0, t.size, _CHUNK):
+            b = min(a + _CHUNK, t.size)
+            s = self.solution.sample(xs, t[a:b], modal=modal, energy=modal)
+            out["w"][a:b] = s.w
+            out["w_t"][a:b] = s.w_t
+            out["engaged"][a:b] = s.engaged
+            if modal:
+                out["eta"][a:b] = s.eta
+                out["eta_t"][a:b] = s.eta_t
+                out["energies"][a:b] = s.energies
         return out
 
-    def _scalar(self, x: float, lo: float, hi: float):
-        """``(t0, f)`` with ``f(tau) -> (w(x), w_t(x))`` of the one segment covering [lo, hi], else None."""
-        segs = self._raw.segments
-        starts = np.array([s.t0 for s in segs])
-        j = int(np.clip(np.searchsorted(starts, lo, side="right") - 1, 0, len(segs) - 1))
-        seg = segs[j]
-        if not (seg.t0 <= lo and hi <= seg.t1) or not hasattr(seg.solution, "projector"):
-            return None
-        W = self._raw.space.state(seg.engaged).modes.shapes([x])[:, 0]
-        return seg.t0, seg.solution.projector(W)
+    @functools.cached_property
+    def _grid(self) -> dict[str, np.ndarray]:
+        return self._sampled(modal=False)
 
-    def displacement(self, x, t) -> np.ndarray:
-        """Exact deflection ``w(x, t)`` [m] at any positions and times: array (n_x, n_t)."""
-        return self._dense(x, t, 0)
+    @functools.cached_property
+    def _modal_grid(self) -> dict[str, np.ndarray]:
+        return self._sampled(modal=True)
 
-    def velocity(self, x, t) -> np.ndarray:
-        """Exact velocity ``w_t(x, t)`` [m/s]: array (n_x, n_t)."""
-        return self._dense(x, t, 1)
+    @property
+    def w(self) -> np.ndarray:
+        return self._grid["w"][:, : self.points.size]
+
+    @property
+    def w_t(self) -> np.ndarray:
+        return self._grid["w_t"][:, : self.points.size]
+
+    @property
+    def w_contact(self) -> np.ndarray:
+        return self._grid["w"][:, self.points.size :]
+
+    @property
+    def w_t_contact(self) -> np.ndarray:
+        return self._grid["w_t"][:, self.points.size :]
+
+    @property
+    def engaged(self) -> np.ndarray:
+        return self._grid["engaged"]
+
+    @functools.cached_property
+    def contact_force(self) -> np.ndarray:
+        force = np.zeros((self.time.size, len(self.contactors)))
+        for i, c in enumerate(self.contactors):
+            g = c.gap - c.direction * self.w_contact[:, i]
+            force[:, i] = np.where(self.engaged[:, i], c.stiffness * np.maximum(-g, 0.0), 0.0)
+        force[np.isnan(self.w_contact).any(axis=1)] = np.nan
+        return force
+
+    @property
+    def eta(self) -> np.ndarray:
+        return self._modal_grid["eta"]
+
+    @property
+    def eta_t(self) -> np.ndarray:
+        return self._modal_grid["eta_t"]
+
+    @functools.cached_property
+    def energy(self) -> dict[str, np.ndarray]:
+        en = self._modal_grid["energies"]
+        kinetic, modal_strain, load_power, damping_power = en.T
+        contactor_energy = np.zeros(self.time.size)
+        spring_at_zero_gap = np.zeros(self.time.size)
+        for i, c in enumerate(self.contactors):
+            wc = self.w_contact[:, i]
+            g = c.gap - c.direction * wc
+            on = self.engaged[:, i]
+            contactor_energy += np.where(on, 0.5 * c.stiffness * g**2, 0.0)
+            spring_at_zero_gap += np.where(on, 0.5 * c.stiffness * wc**2, 0.0)
+        strain = modal_strain - spring_at_zero_gap
+        total = kinetic + strain + contactor_energy
+        dt = np.diff(self.time)
+
+        def cumulative(p: np.ndarray) -> np.ndarray:
+            return np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * dt)])
+
+        input_work = cumulative(load_power)
+        dissipated = cumulative(damping_power)
+        return {
+            "kinetic": kinetic, "strain": strain, "contactor": contactor_energy, "input_work": input_work,
+            "dissipated": dissipated, "total": total, "residual": total[0] + input_work - dissipated - total,
+        }
+
+    # ------------------------------------------------------------------ dense output
+    def _check_points(self, x: Any) -> np.ndarray:
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        L = self.beam.length
+        bad = ~np.isfinite(x) | (x < 0.0) | (x > L * (1.0 + 1e-12))
+        if bad.any():
+            raise ParameterError(f"x: {x[bad][0]:g} m is off the beam [0, {L:g}] m")
+        return x
+
+    def displacement(self, x: Any, t: Any) -> np.ndarray:
+        """Exact deflection ``w(x, t)`` [m] at any positions and times: array (n_x, n_t).
+
+        Raises ParameterError for a point off the beam or a time outside
+        ``[0, end_time]``; times after a chattering stop give NaN.
+        """
+        x = self._check_points(x)
+        t = self.solution.check_times(t, self.end_time)
+        return self.solution.sample(x, t).w.T
+
+    def velocity(self, x: Any, t: Any) -> np.ndarray:
+        """Exact velocity ``w_t(x, t)`` [m/s]: array (n_x, n_t); see :meth:`displacement`."""
+        x = self._check_points(x)
+        t = self.solution.check_times(t, self.end_time)
+        return self.solution.sample(x, t).w_t.T
 
     # ------------------------------------------------------------------ derived
-    def metrics(self) -> dict[str, Any]:
-        """Response metrics (keys of ``impactbeam simulate --json``); see :mod:`impactbeam.metrics`."""
+    def metrics(self, *, impacts: bool = True) -> dict[str, Any]:
+        """Response metrics (keys of ``impactbeam simulate --json``); see :mod:`impactbeam.metrics`.
+
+        Parameters
+        ----------
+        impacts : bool
+            Include the per-impact table (``"impacts"``); sweeps leave it out.
+        """
         from .metrics import compute_metrics
 
-        return compute_metrics(self)
+        return compute_metrics(self, impacts=impacts)
 
     def to_xarray(self) -> xr.Dataset:
         """The result as a labelled :class:`xarray.Dataset` with units in the attributes."""
@@ -218,13 +309,14 @@ class SimulationResult:
                 "contactor_position": (
                     "contactor", np.array([c.position for c in self.contactors], dtype=float), {"units": "m"}
                 ),
-                "mode": ("mode", np.arange(1, self.eta.shape[1] + 1)),
+                "mode": ("mode", np.arange(1, self.n_modes + 1)),
             },
             attrs={
                 "title": f"impactbeam simulation: {self.scenario_name}",
                 "impactbeam_version": __version__,
                 "status": self.status,
                 "message": self.message,
+                "warnings": "; ".join(self.warnings),
                 "n_modes": self.n_modes,
                 "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
                 **{f"solver_{k}": v for k, v in self.options.items()},

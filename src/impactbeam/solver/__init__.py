@@ -11,16 +11,17 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from ..beam import Beam, Contactor
-from ..exceptions import ParameterError
+from ..exceptions import ParameterError, warn
 from ..loading import Excitation, InitialCondition
-from .engine import Event, integrate
+from .engine import integrate
+from .solution import Event, PiecewiseSolution, Solution
 from .options import Damping, SolverOptions
 
 if TYPE_CHECKING:
     from ..result import SimulationResult
     from ..scenario import Scenario
 
-__all__ = ["simulate", "simulate_system", "Damping", "SolverOptions", "Event"]
+__all__ = ["simulate", "simulate_system", "Damping", "SolverOptions", "Event", "Solution", "PiecewiseSolution"]
 
 Method = Literal["exact", "ivp"]
 
@@ -58,16 +59,35 @@ def simulate_system(
         raise ParameterError(f"output.points: every point must lie on the beam [0, {beam.length:g}] m")
     if excitation.kind == "point_force" and excitation.position is not None and excitation.position > beam.length * (1 + 1e-12):
         raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
+    _check_distinct(contactors)
     if method == "ivp":
         from .reference import integrate_ivp
 
-        raw = integrate_ivp(beam, contactors, damping, excitation, initial, options, pts_arr)
+        solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, options)
     elif method == "exact":
-        raw = integrate(beam, contactors, damping, excitation, initial, options, pts_arr, progress)
+        solution = integrate(beam, contactors, damping, excitation, initial, options, progress)
     else:
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
+    for text in solution.warnings:
+        warn(text)
     opts = {"modes": options.modes, "time_step": options.time_step, "end_time": options.end_time, "method": method}
-    return SimulationResult.from_raw(raw, beam, contactors, pts_arr, options.modes, name, opts)
+    return SimulationResult(
+        solution, pts_arr, beam, contactors, options.modes, options.time_step, options.end_time, name, opts
+    )
+
+
+def _check_distinct(contactors: tuple[Contactor, ...]) -> None:
+    """Refuse two contactors at one point on one side with one gap: they would switch endlessly."""
+    seen: dict[tuple[float, str, float], int] = {}
+    for i, c in enumerate(contactors):
+        key = (c.position, c.side, c.gap)
+        if key in seen:
+            j = seen[key]
+            raise ParameterError(
+                f"contactors.{i}: same position, side and gap as contactors.{j}; use one contactor of stiffness "
+                f"{contactors[j].stiffness:g} + {c.stiffness:g} N/m instead"
+            )
+        seen[key] = i
 
 
 def simulate(
@@ -104,14 +124,21 @@ def simulate(
     projection between the mode sets of two states (paper eq. 12), which is
     an L2 projection of the displacement and velocity onto N modes.
 
-    Events are detected on a scan grid of ``solver.time_step`` refined so
-    that it is at most 1/8 of the shortest modal period of any state; a
-    crossing between two grid points, or a grazing dip below zero between two
-    open grid points (found from the exact derivative), is then located by
-    Brent's method on the closed form. Two crossings closer than one scan
-    interval whose derivative does not change sign between grid points could
-    be missed; with the 1/8-period rule this needs a component faster than
-    every retained mode.
+    Events are located on the closed form, independently of the output
+    step: the scan advances by steps that a bound on the second derivative of
+    each contactor's opening (from the modal amplitudes and frequencies)
+    proves free of any crossing, subdivides a step that it cannot prove, and
+    refines a proven single crossing by Brent's method to
+    ``solver.event_tolerance``. A dip into a stop deeper than 1e-12 of the
+    beam length cannot be missed; a tangency at the start of a segment (zero
+    gap at rest, a contactor just switched) is decided by the first
+    derivative of the opening that is not zero up to round-off. The output
+    samples (``result.time``) are evaluated from the exact solution only when
+    asked for, and the metrics come from the exact solution (extrema by
+    branch and bound on the closed form, impulses in closed form).
+
+    Warnings the solver raises (:class:`~impactbeam.exceptions.ImpactBeamWarning`)
+    are also listed in ``result.warnings``.
     """
     return simulate_system(
         scenario.beam,

@@ -1,87 +1,44 @@
-"""Event-driven exact integration of the piecewise-linear modal model (paper section 2).
+"""The exact event-driven solver (paper section 2): Python side of the one compiled engine.
 
-Between events the state (set of engaged contactors) and the load form are
-fixed and every mode has a closed-form response
-(:mod:`~impactbeam.solver.closed_form`). The integrator walks from event to
-event: it evaluates the closed form on the sampling grid (which also yields
-the output), detects a crossing of a contactor's opening
-``g = gap - s w(a)`` between two grid points (or a grazing dip below zero
-between them, found from the exact derivative), locates it with Brent's
-method on the closed form, switches the state there and projects the modal
-displacement and velocity onto the new modes (paper eqs. 11-12).
+:func:`integrate` packs the problem (the states' modes, shapes at the
+contactors, load weights and transfer matrices of eq. 12) into arrays,
+runs the compiled loop of :mod:`~impactbeam.solver._loop`, and supplies it
+with what it asks for: a state the first time it is visited (states are
+built lazily, so ``n`` contactors cost what the visited states cost, not
+``2**n``), a transfer matrix the first time a switch between two states
+occurs, larger record arrays, and, at checkpoints, progress reports and the
+chance for Ctrl-C to stop the run. It returns the exact piecewise solution,
+:class:`~impactbeam.solver.solution.Solution`; nothing is sampled here.
+
+Packed problems are cached across runs on what they depend on (beam,
+contactor positions, stiffnesses, damping, load distribution, mode count,
+projection), not on gaps, sides or the load's time history, so a parameter
+study over those reuses every mode and transfer matrix.
 """
 
 from __future__ import annotations
 
-import math
+from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..beam import Beam, Contactor
-from ..loading import Excitation, InitialCondition, TimePiece, time_pieces
+from ..loading import Excitation, InitialCondition, time_pieces
 from ..modes import mode_set
-from . import kernels
-from .closed_form import ClosedFormSegment, LoadForm
+from . import _loop
 from .options import Damping, SolverOptions
+from .solution import Event, Solution
 from .states import StateModel, StateSpace
 
-__all__ = ["Event", "Segment", "RawSolution", "integrate"]
+__all__ = ["integrate", "initial_coordinates", "pack"]
 
-_CHUNK = 2048
-
-
-@dataclass(frozen=True)
-class Event:
-    """An impact (contactor engages) or rebound (it releases) at an exact time."""
-
-    time: float
-    kind: str  # "impact" | "rebound"
-    contactor: int
-    velocity: float  # w_t at the contactor [m/s]
+_BUDGET = 200_000  # evaluations of the closed form between checkpoints (~20-50 ms)
+_CACHE: OrderedDict[tuple, _Packed] = OrderedDict()
+_CACHE_SIZE = 64
 
 
-@dataclass(frozen=True, eq=False)
-class Segment:
-    """Closed-form modal response on ``[t0, t1]`` in one state (dense output)."""
-
-    t0: float
-    t1: float
-    engaged: tuple[int, ...]
-    solution: ClosedFormSegment
-    piece: TimePiece
-
-
-@dataclass(eq=False)
-class RawSolution:
-    """What :func:`integrate` returns; :class:`~impactbeam.result.SimulationResult` wraps it."""
-
-    time: np.ndarray
-    w: np.ndarray  # (time, point)
-    w_t: np.ndarray
-    w_contact: np.ndarray  # (time, contactor)
-    w_t_contact: np.ndarray
-    state_code: np.ndarray  # (time,) index into state_keys
-    state_keys: list[tuple[int, ...]]
-    kinetic: np.ndarray
-    modal_strain: np.ndarray  # 1/2 sum omega^2 eta^2 (includes engaged springs at zero gap)
-    load_power: np.ndarray  # u(t) sum p_n eta'_n
-    damping_power: np.ndarray  # sum 2 xi omega eta'^2
-    eta: np.ndarray  # (time, mode) in the basis of the state at that time
-    eta_t: np.ndarray
-    events: list[Event]
-    segments: list[Segment]
-    space: StateSpace
-    status: int
-    message: str
-    switch_energy_jumps: list[float]
-
-
-def initial_coordinates(
-    beam: Beam, initial: InitialCondition, n_modes: int
-) -> tuple[np.ndarray, np.ndarray]:
+def initial_coordinates(beam: Beam, initial: InitialCondition, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
     """Free-state modal displacement and velocity at t = 0."""
     ms = mode_set(beam, (), n_modes)
     eta = np.zeros(ms.count)
@@ -101,369 +58,167 @@ def initial_coordinates(
     return eta, deta
 
 
-def _segment(st: StateModel, piece: TimePiece, t: float, eta: np.ndarray, deta: np.ndarray) -> ClosedFormSegment:
-    tau = t - piece.t0
-    p = st.load_weights
-    a = p * (piece.const + piece.slope * tau) + st.gap_force
-    b = p * piece.slope if piece.slope else None
-    d = p * piece.amp if piece.amp else None
-    return ClosedFormSegment(st.dyn, LoadForm(a, b, d, piece.Omega, piece.phase + piece.Omega * tau), eta, deta)
+def _grow(a: np.ndarray, n: int) -> np.ndarray:
+    out = np.zeros((n,) + a.shape[1:], dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
 
 
-class _Integrator:
-    def __init__(
-        self,
-        beam: Beam,
-        contactors: tuple[Contactor, ...],
-        damping: Damping,
-        excitation: Excitation,
-        initial: InitialCondition,
-        options: SolverOptions,
-        points: np.ndarray,
-        progress: Callable[[float], None] | None,
-    ) -> None:
-        self.opt = options
-        self.contactors = contactors
-        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, points)
-        self.pieces = time_pieces(excitation, options.end_time)
-        self.gap = np.array([c.gap for c in contactors])
-        self.side = np.array([c.direction for c in contactors])
-        self.tol_h = 1e-12 * beam.length
-        self.progress = progress
-        dt = options.time_step
-        # scan step: at most 1/8 of the shortest period of any state (the all-engaged one is stiffest)
-        all_eng = tuple(range(len(contactors)))
-        wmax = max(self.space.state(()).omega_max, self.space.state(all_eng).omega_max if contactors else 0.0)
-        self.sub = max(1, math.ceil(dt * wmax / (2.0 * math.pi) * 8.0)) if wmax > 0 else 1
-        self.h = dt / self.sub
-        self.n_out = int(math.floor(options.end_time / dt * (1.0 + 1e-12))) + 1
-        self.time = np.arange(self.n_out) * dt
-        n_p = points.size
-        n_c = len(contactors)
-        nm = options.modes
-        # filled segment by segment; rows never reached (a run stopped early) become NaN at the end
-        self.w = np.empty((self.n_out, n_p))
-        self.w_t = np.empty((self.n_out, n_p))
-        self.wc = np.empty((self.n_out, n_c))
-        self.wtc = np.empty((self.n_out, n_c))
-        self.code = np.full(self.n_out, -1, dtype=np.int16)
-        self.kin = np.empty(self.n_out)
-        self.strain = np.empty(self.n_out)
-        self.lpow = np.empty(self.n_out)
-        self.dpow = np.empty(self.n_out)
-        self.eta = np.empty((self.n_out, nm))
-        self.eta_t = np.empty((self.n_out, nm))
+class _Packed:
+    """The visited states of one problem in arrays for the compiled loop (grown on demand)."""
+
+    def __init__(self, space: StateSpace, preserve: bool) -> None:
+        self.space = space
+        self.preserve = preserve
+        nm = space.n_modes
+        nc = len(space.contactors)
+        cap = min(4, 1 << nc)
+        self.reg = np.zeros((cap, nm), dtype=np.int64)
+        self.dec = np.zeros((cap, nm))
+        self.wdh = np.zeros((cap, nm))
+        self.om = np.zeros((cap, nm))
+        self.Wc = np.zeros((cap, nc, nm))
+        self.pw = np.zeros((cap, nm))
+        self.smask = np.full(cap, -1, dtype=np.int64)
+        self.models: list[StateModel] = []
         self.keys: list[tuple[int, ...]] = []
-        self.events: list[Event] = []
-        self.segments: list[Segment] = []
-        self.jumps: list[float] = []
-        self.projection_warning: str | None = None
+        self.Tm = np.zeros((4, nm, nm))
+        self.tr_from = np.full(4, -1, dtype=np.int64)
+        self.tr_to = np.full(4, -1, dtype=np.int64)
+        self.ntr = 0
+        self._rows: dict[bytes, np.ndarray] = {}
+        self.add_state(0)
 
-    # ------------------------------------------------------------------ helpers
-    def _code(self, engaged: tuple[int, ...]) -> int:
-        if engaged not in self.keys:
-            self.keys.append(engaged)
-        return self.keys.index(engaged)
+    def rows(self, x: np.ndarray) -> np.ndarray:
+        """Mode shapes of every built state at ``x``: (n_states, len(x), n_modes), cached."""
+        x = np.ascontiguousarray(x, dtype=float)
+        key = x.tobytes()
+        hit = self._rows.get(key)
+        if hit is None or hit.shape[0] < self.nslots:
+            done = 0 if hit is None else hit.shape[0]
+            new = [st.modes.shapes(x).T for st in self.models[done:]]
+            hit = np.ascontiguousarray(np.stack(new if hit is None else [*hit, *new]))
+            self._rows[key] = hit
+        return hit
 
-    def _orient(self, engaged: tuple[int, ...]) -> np.ndarray:
-        o = np.ones(len(self.contactors))
-        o[list(engaged)] = -1.0
-        return o
+    @property
+    def nslots(self) -> int:
+        return len(self.models)
 
-    def _h(self, st: StateModel, orient: np.ndarray, eta: np.ndarray, deta: np.ndarray):
-        wc = st.W_contact @ eta
-        dwc = st.W_contact @ deta
-        g = self.gap[:, None] - self.side[:, None] * wc
-        dg = -self.side[:, None] * dwc
-        return orient[:, None] * g, orient[:, None] * dg, wc, dwc
+    def add_state(self, mask: int) -> int:
+        """Build the state with engaged-contactor bit mask ``mask``; its slot."""
+        key = tuple(i for i in range(len(self.space.contactors)) if (mask >> i) & 1)
+        st = self.space.state(key)
+        if st.modes.count != self.space.n_modes:
+            raise RuntimeError(f"state {key}: {st.modes.count} modes instead of {self.space.n_modes}")
+        s = self.nslots
+        if s >= self.smask.size:
+            n = 2 * self.smask.size
+            for name in ("reg", "dec", "wdh", "om", "Wc", "pw"):
+                setattr(self, name, _grow(getattr(self, name), n))
+            self.smask = np.concatenate([self.smask, np.full(n - s, -1, dtype=np.int64)])
+        dyn = st.dyn
+        self.reg[s] = np.where(dyn.under, 0, np.where(dyn.over, 2, 1))
+        self.dec[s] = dyn.decay
+        self.wdh[s] = np.where(dyn.under, dyn.wd, dyn.wh)
+        self.om[s] = st.modes.omega
+        self.Wc[s] = st.W_contact
+        self.pw[s] = st.load_weights
+        self.smask[s] = mask
+        self.models.append(st)
+        self.keys.append(key)
+        return s
 
-    def _energy(self, st: StateModel, eta: np.ndarray, deta: np.ndarray) -> float:
-        """Total mechanical energy (beam + supports + engaged contactors) of one modal state."""
-        wc = st.W_contact @ eta
-        E = 0.5 * float(deta @ deta) + 0.5 * float(np.sum(st.modes.omega**2 * eta**2))
-        for i in st.engaged:
-            c = self.contactors[i]
-            g = c.gap - c.direction * wc[i]
-            E += 0.5 * c.stiffness * (g**2 - wc[i] ** 2)
-        return E
+    def add_transfer(self, frm: int, to: int) -> None:
+        """The matrix carrying modal coordinates from slot ``frm`` to slot ``to`` (eq. 12)."""
+        k = self.ntr
+        if k >= self.tr_from.size:
+            n = 2 * self.tr_from.size
+            self.Tm = _grow(self.Tm, n)
+            self.tr_from = np.concatenate([self.tr_from, np.full(n - k, -1, dtype=np.int64)])
+            self.tr_to = np.concatenate([self.tr_to, np.full(n - k, -1, dtype=np.int64)])
+        self.Tm[k] = self.space.transfer(self.keys[to], self.keys[frm], self.preserve)
+        self.tr_from[k] = frm
+        self.tr_to[k] = to
+        self.ntr = k + 1
 
-    def _desired_switch(self, st, seg: ClosedFormSegment, orient, tau1: float, just: int | None) -> int | None:
-        """Contactor whose state is inconsistent at the start of a segment, if any.
 
-        For the contactor ``just`` switched at this instant only the direction of
-        motion is judged: the projection onto the new truncated mode set (eq. 12)
-        moves ``w(a)`` slightly, so its opening may start a hair on the wrong side.
-        """
-        if not self.contactors:
-            return None
-        e0, d0 = seg.state_at(0.0)
-        h0, dh0, _, _ = self._h(st, orient, e0[:, None], d0[:, None])
-        if just is None and np.all(h0[:, 0] > self.tol_h):
-            return None  # every contactor clearly on its consistent side
-        e1, d1 = seg.state_at(tau1)
-        h1, dh1, _, _ = self._h(st, orient, e1[:, None], d1[:, None])
-        h = np.concatenate([h0, h1], axis=1)
-        dh = np.concatenate([dh0, dh1], axis=1)
-        for c in range(len(self.contactors)):
-            if c == just:
-                if dh[c, 0] * tau1 < -self.tol_h:
-                    return c
-                continue
-            if h[c, 0] < -self.tol_h:
-                return c  # already on the wrong side (e.g. released inside the contactor)
-            if abs(h[c, 0]) <= self.tol_h:
-                if dh[c, 0] * tau1 < -self.tol_h:
-                    return c
-                if abs(dh[c, 0]) * tau1 <= self.tol_h and h[c, 1] < -self.tol_h:
-                    return c
-        return None
+def pack(
+    beam: Beam,
+    contactors: tuple[Contactor, ...],
+    damping: Damping,
+    excitation: Excitation,
+    options: SolverOptions,
+) -> _Packed:
+    """The packed problem, from the cache when its modes and transfers are already known."""
+    key = (
+        beam, tuple((c.position, c.stiffness) for c in contactors), damping, excitation.kind,
+        excitation.position, options.modes, options.projection,
+    )
+    hit = _CACHE.get(key)
+    if hit is not None:
+        _CACHE.move_to_end(key)
+        return hit
+    # gaps and sides enter the compiled loop directly: the states do not depend on them
+    neutral = tuple(Contactor(c.position, c.stiffness, 0.0, "below") for c in contactors)
+    space = StateSpace(beam, neutral, damping, excitation, options.modes, np.zeros(0))
+    packed = _Packed(space, options.projection == "contact")
+    _CACHE[key] = packed
+    if len(_CACHE) > _CACHE_SIZE:
+        _CACHE.popitem(last=False)
+    return packed
 
-    # ------------------------------------------------------------------ event location
-    def _locate(self, st, seg, orient, c: int, lo: float, hi: float, hlo: float, dlo: float, dhi: float) -> float | None:
-        o, s, gap = orient[c], self.side[c], self.gap[c]
-        f = seg.projector(-o * s * st.W_contact[c], o * gap)
 
-        def h(t: float) -> float:
-            return f(t)[0]
+class _Records:
+    """Growing record arrays of segments, events and energy jumps."""
 
-        def dh(t: float) -> float:
-            return f(t)[1]
+    def __init__(self, nm: int) -> None:
+        n = 64
+        self.seg_t0 = np.empty(n)
+        self.seg_t1 = np.empty(n)
+        self.seg_s = np.empty(n, dtype=np.int64)
+        self.seg_k = np.empty(n, dtype=np.int64)
+        self.seg_eta = np.empty((n, nm))
+        self.seg_deta = np.empty((n, nm))
+        self.ev_t = np.empty(n)
+        self.ev_kind = np.empty(n, dtype=np.int64)
+        self.ev_c = np.empty(n, dtype=np.int64)
+        self.ev_v = np.empty(n)
+        self.jumps = np.empty(n)
 
-        tol = self.opt.event_tolerance
-        hh = h(hi)
-        if hlo <= self.tol_h:
-            # starting on the contact surface: move to the maximum of h first
-            if dlo > 0 and dh(hi) < 0:
-                lo = brentq(dh, lo, hi, xtol=tol)
-                hlo = h(lo)
-            if hlo <= 0:
-                return None
-        if hh > 0:
-            # grazing: both ends open, the derivative changes sign
-            if not (dlo < 0 < dhi):
-                return None
-            tmin = brentq(dh, lo, hi, xtol=tol)
-            if h(tmin) > 0:
-                return None
-            hi = tmin
-            if h(hi) == 0:
-                return hi
-        return float(brentq(h, lo, hi, xtol=tol, rtol=4 * np.finfo(float).eps, maxiter=200))
+    def grow(self, ic: np.ndarray) -> None:
+        if ic[_loop.I_NSEG] + 1 > self.seg_t0.size:
+            n = 2 * self.seg_t0.size
+            for name in ("seg_t0", "seg_t1", "seg_s", "seg_k", "seg_eta", "seg_deta"):
+                setattr(self, name, _grow(getattr(self, name), n))
+        if ic[_loop.I_NEV] + 1 > self.ev_t.size or ic[_loop.I_NJUMP] + 1 > self.jumps.size:
+            n = 2 * max(self.ev_t.size, self.jumps.size)
+            for name in ("ev_t", "ev_kind", "ev_c", "ev_v", "jumps"):
+                setattr(self, name, _grow(getattr(self, name), n))
 
-    def _release_in_tension(self, st, seg, orient, c: int, lo: float, hi: float) -> float:
-        """Where a contactor on the wrong side of its state turns back (largest tension or penetration)."""
-        f = seg.projector(-orient[c] * self.side[c] * st.W_contact[c], orient[c] * self.gap[c])
-        return float(brentq(lambda t: f(t)[1], lo, hi, xtol=self.opt.event_tolerance))
 
-    # ------------------------------------------------------------------ main loop
-    def _run_from(self, eta: np.ndarray, deta: np.ndarray) -> RawSolution:
-        opt = self.opt
-        T = opt.end_time
-        engaged: tuple[int, ...] = ()
-        t = 0.0
-        k_piece = 0
-        status, message = 0, "The simulation reached end_time."
-        toggles_at_t: dict[int, int] = {}
-        last_t = -1.0
-        just: int | None = None
-        while t < T and k_piece < len(self.pieces):
-            piece = self.pieces[k_piece]
-            st = self.space.state(engaged)
-            orient = self._orient(engaged)
-            seg = _segment(st, piece, t, eta, deta)
-            t_end = min(piece.t1, T)
-            # consistency at the start of the segment (zero gap at rest, grazing, release)
-            c_bad = self._desired_switch(st, seg, orient, min(self.h, t_end - t) if t_end > t else self.h, just)
-            if c_bad is not None:
-                if t != last_t:
-                    toggles_at_t, last_t = {}, t
-                toggles_at_t[c_bad] = toggles_at_t.get(c_bad, 0) + 1
-                if toggles_at_t[c_bad] <= 2:
-                    engaged, eta, deta = self._switch(st, engaged, c_bad, t, eta, deta)
-                    just = c_bad
-                    if len(self.events) >= opt.max_events:
-                        status, message = 1, self._chatter_message(t)
-                        break
-                    continue
-            te, c_hit = self._advance(st, seg, orient, t, t_end)
-            self.segments.append(Segment(t, te, engaged, seg, piece))
-            eta, deta = seg.state_at(te - t)
-            t = te
-            if self.progress is not None:
-                self.progress(t)
-            just = c_hit
-            if c_hit is not None:
-                engaged, eta, deta = self._switch(st, engaged, c_hit, t, eta, deta)
-                if len(self.events) >= opt.max_events:
-                    status, message = 1, self._chatter_message(t)
-                    break
-            elif t >= piece.t1:
-                k_piece += 1
-        if self.projection_warning is not None:
-            message = f"{message} Warning: {self.projection_warning}"
-        unset = self.code < 0
-        if unset.any():
-            for arr in (self.w, self.w_t, self.wc, self.wtc, self.kin, self.strain, self.lpow, self.dpow, self.eta, self.eta_t):
-                arr[unset] = np.nan
-        return RawSolution(
-            self.time, self.w, self.w_t, self.wc, self.wtc, self.code, self.keys, self.kin, self.strain,
-            self.lpow, self.dpow, self.eta, self.eta_t, self.events, self.segments, self.space, status,
-            message, self.jumps,
-        )
+def _pieces(excitation: Excitation, end_time: float) -> tuple[np.ndarray, ...]:
+    pieces = time_pieces(excitation, end_time)
+    return tuple(
+        np.array([getattr(p, f) for p in pieces], dtype=float)
+        for f in ("t0", "t1", "const", "slope", "amp", "Omega", "phase")
+    )
 
-    def _chatter_message(self, t: float) -> str:
-        return (
-            f"Stopped at t = {t:.9g} s after {len(self.events)} events (solver.max_events): "
-            "chattering contact; later samples are NaN."
-        )
 
-    def _switch(self, st, engaged, c, t, eta, deta):
-        new = tuple(sorted(set(engaged) ^ {c}))
-        kind = "impact" if c in new else "rebound"
-        E_before = self._energy(st, eta, deta)
-        vel = float(st.W_contact[c] @ deta)
-        if self.events and self.events[-1].time == t and self.events[-1].contactor == c:
-            self.events.pop()  # an impact and a rebound at one instant cancel (grazing touch)
-        else:
-            self.events.append(Event(t, kind, c, vel))
-        P = self.space.transfer(new, engaged, self.opt.projection == "contact")
-        w_before = st.W_contact @ eta
-        eta, deta = P @ eta, P @ deta
-        moved = np.abs(self.space.state(new).W_contact @ eta - w_before)
-        # floor 1e-6 L: with zero gap the deflection at the event is round-off
-        scale = np.maximum(np.maximum(self.gap, np.abs(w_before)), 1e6 * self.tol_h)
-        worst = int(np.argmax(moved / scale))
-        if moved[worst] > 0.05 * scale[worst] and self.projection_warning is None:
-            self.projection_warning = (
-                f"At t = {t:.6g} s the projection onto {self.opt.modes} modes moved the deflection at "
-                f"contactor {worst} by {moved[worst]:.3g} m ({100 * moved[worst] / scale[worst]:.0f} % of its gap "
-                "or deflection): the contactor is too stiff for this number of modes; add modes."
-            )
-        self.jumps.append(self._energy(self.space.state(new), eta, deta) - E_before)
-        return new, eta, deta
-
-    def _advance(self, st: StateModel, seg: ClosedFormSegment, orient, t0: float, t_end: float):
-        """Scan [t0, t_end] for the first event; store the output; return (end time, contactor hit or None)."""
-        hit_tau, hit_c = None, None
-        if self.contactors:
-            hit_tau, hit_c = self._scan(st, seg, orient, t0, t_end)
-        t1 = t_end if hit_tau is None else t0 + hit_tau
-        self._output(st, seg, t0, t1)
-        return t1, hit_c
-
-    def _scan(self, st: StateModel, seg: ClosedFormSegment, orient, t0: float, t_end: float):
-        h = self.h
-        k = math.ceil(t0 / h - 1e-9)
-        k_last = math.floor(t_end / h + 1e-9)
-        V = (orient * -self.side)[:, None] * st.W_contact  # h = orient (gap - s w) = orient*gap + V @ eta
-        if kernels.AVAILABLE and st.dyn.all_under:
-            ld = seg.load
-            tau, c = kernels.scan(
-                t0, h, k, k_last, t_end, st.dyn.mu, V * seg._A[None, :], V * seg._B[None, :],
-                orient * self.gap, V @ seg._particular_coefficients(), ld.Omega, ld.phi, ld.d is not None,
-                orient < 0, self.tol_h, self.opt.event_tolerance,
-            )
-            return (None, None) if c < 0 else (float(tau), int(c))
-        base = (orient * self.gap)[:, None]
-        hv, dv = seg.evaluate_grid(0.0, h, 1, V)
-        hp, dhp = hv[:, 0] + base[:, 0], dv[:, 0]
-        tau_prev = 0.0
-        n_chunk = 256
-        while True:
-            n = max(0, min(n_chunk, k_last + 1 - k))
-            tau0 = k * h - t0
-            if n:
-                H, dH = seg.evaluate_grid(tau0, h, n, V)
-                H = H + base
-                taus = tau0 + h * np.arange(n)
-            else:
-                H = np.zeros((V.shape[0], 0))
-                dH = H
-                taus = np.zeros(0)
-            last = k + n > k_last
-            if last and (t_end - t0) > (taus[-1] if n else 0.0) + 1e-15:
-                He, dHe = seg.evaluate_grid(t_end - t0, h, 1, V)
-                H = np.concatenate([H, He + base], axis=1)
-                dH = np.concatenate([dH, dHe], axis=1)
-                taus = np.append(taus, t_end - t0)
-            if taus.size:
-                Hprev = np.concatenate([hp[:, None], H[:, :-1]], axis=1)
-                dHprev = np.concatenate([dhp[:, None], dH[:, :-1]], axis=1)
-                tprev = np.concatenate([[tau_prev], taus[:-1]])
-                start_touch = np.abs(Hprev) <= self.tol_h
-                cross = (H <= 0.0) & ((Hprev > 0.0) | (start_touch & (dHprev > 0)))
-                dtau = taus - tprev
-                graze = (Hprev > 0) & (H > 0) & (dHprev < 0) & (dH > 0)
-                graze &= (Hprev < np.abs(dHprev) * dtau) | (H < np.abs(dH) * dtau)
-                # a contactor left on the wrong side of its state by the projection of
-                # eq. 12 (engaged but open: in tension; free but penetrated) switches
-                # where its opening turns back before reaching the right side: a
-                # one-sided spring cannot pull, and a free beam cannot pass the stop
-                tension = (Hprev <= 0.0) & (H < 0.0) & (dHprev > 0.0) & (dH <= 0.0)
-                cand = (cross | graze | tension) & (dtau > 0.0)  # tau = 0 may be both ends of the first interval
-                if cand.any():
-                    for j in np.nonzero(cand.any(axis=0))[0]:
-                        best = None
-                        for c in np.nonzero(cand[:, j])[0]:
-                            if tension[c, j] and not cross[c, j]:
-                                r = self._release_in_tension(st, seg, orient, int(c), tprev[j], taus[j])
-                            else:
-                                r = self._locate(
-                                    st, seg, orient, int(c), tprev[j], taus[j], Hprev[c, j], dHprev[c, j], dH[c, j]
-                                )
-                            if r is not None and (best is None or r < best[0]):
-                                best = (r, int(c))
-                        if best is not None:
-                            return best
-                hp, dhp = H[:, -1], dH[:, -1]
-                tau_prev = taus[-1]
-            if last:
-                return None, None
-            k += n
-            n_chunk = min(2 * n_chunk, 8192)
-
-    def _output(self, st: StateModel, seg: ClosedFormSegment, t0: float, t1: float) -> None:
-        """Exact output at the sampling times in [t0, t1) (t1 included at the end of the run)."""
-        dt = self.opt.time_step
-        i0 = max(0, math.ceil(t0 / dt - 1e-9))
-        i1 = self.n_out if t1 >= self.opt.end_time else min(self.n_out, math.ceil(t1 / dt - 1e-9))
-        code = self._code(st.engaged)
-        if i1 <= i0:
-            return
-        if kernels.AVAILABLE and st.dyn.all_under:
-            ld = seg.load
-            n = st.modes.count
-            kernels.output(
-                t0, dt, i0, i1, st.dyn.mu, seg._A, seg._B, seg._particular_coefficients(), ld.Omega, ld.phi,
-                ld.d is not None, ld.a - st.gap_force, ld.b if ld.b is not None else np.zeros(n),
-                ld.d if ld.d is not None else np.zeros(n), st.modes.omega, 2.0 * st.dyn.decay, st.W_out,
-                st.W_contact, self.w, self.w_t, self.wc, self.wtc, self.kin, self.strain, self.lpow, self.dpow,
-                self.eta, self.eta_t,
-            )
-            self.code[i0:i1] = code
-            return
-        om = st.modes.omega[:, None]
-        damp2 = (2.0 * st.dyn.decay)[:, None]
-        for a in range(i0, i1, 8192):
-            b = min(a + 8192, i1)
-            tau0 = a * dt - t0
-            eta, deta = seg.evaluate_grid(tau0, dt, b - a)
-            sl = slice(a, b)
-            self.w[sl] = (st.W_out @ eta).T
-            self.w_t[sl] = (st.W_out @ deta).T
-            if self.contactors:
-                self.wc[sl] = (st.W_contact @ eta).T
-                self.wtc[sl] = (st.W_contact @ deta).T
-            self.code[sl] = code
-            self.kin[sl] = 0.5 * np.einsum("ij,ij->j", deta, deta)
-            oe = om * eta
-            self.strain[sl] = 0.5 * np.einsum("ij,ij->j", oe, oe)
-            f = seg.force(tau0 + dt * np.arange(b - a)) - st.gap_force[:, None]
-            self.lpow[sl] = np.einsum("ij,ij->j", f, deta)
-            self.dpow[sl] = np.einsum("ij,ij->j", damp2 * deta, deta)
-            n = eta.shape[0]
-            self.eta[sl, :n] = eta.T
-            self.eta_t[sl, :n] = deta.T
+def _call(pk: _Packed, con: tuple[np.ndarray, ...], pcs: tuple[np.ndarray, ...], opt: SolverOptions, tol_h: float,
+          fc: np.ndarray, ic: np.ndarray, eta: np.ndarray, deta: np.ndarray, toggles: np.ndarray,
+          rec: _Records) -> int:
+    try:
+        return int(_loop.run(
+            pk.reg, pk.dec, pk.wdh, pk.om, pk.Wc, pk.pw, pk.smask, pk.Tm, pk.tr_from, pk.tr_to, *con, *pcs,
+            float(opt.end_time), tol_h, float(opt.event_tolerance), int(opt.max_events), _BUDGET,
+            fc, ic, eta, deta, toggles, rec.seg_t0, rec.seg_t1, rec.seg_s, rec.seg_k, rec.seg_eta, rec.seg_deta,
+            rec.ev_t, rec.ev_kind, rec.ev_c, rec.ev_v, rec.jumps,
+        ))
+    except SystemError as exc:  # a signal that arrived while numba converted the arguments
+        if isinstance(exc.__cause__ or exc.__context__, KeyboardInterrupt):
+            raise KeyboardInterrupt from None
+        raise
 
 
 def integrate(
@@ -473,19 +228,85 @@ def integrate(
     excitation: Excitation,
     initial: InitialCondition,
     options: SolverOptions,
-    points: np.ndarray,
     progress: Callable[[float], None] | None = None,
-) -> RawSolution:
-    """Run the event-driven exact integration; see :func:`impactbeam.simulate`.
+) -> Solution:
+    """Run the exact event-driven integration; see :func:`impactbeam.simulate`.
 
-    Problems whose every state is under-damped (up to 3 contactors, no progress
-    callback) run in the compiled loop of :mod:`~impactbeam.solver.fast`, which is
-    tested to reproduce this Python loop; everything else runs here.
+    Returns
+    -------
+    Solution
+        The exact piecewise modal solution with its events.
     """
-    from . import fast
+    contactors = tuple(contactors)
+    pk = pack(beam, contactors, damping, excitation, options)
+    nm = options.modes
+    con = (
+        np.array([c.gap for c in contactors], dtype=float),
+        np.array([c.direction for c in contactors], dtype=float),
+        np.array([c.stiffness for c in contactors], dtype=float),
+    )
+    pcs = _pieces(excitation, options.end_time)
+    tol_h = 1e-12 * beam.length
+    fc = np.zeros(_loop.N_FLOAT)
+    fc[_loop.F_LAST_T] = -1.0
+    ic = np.zeros(_loop.N_INT, dtype=np.int64)
+    ic[[_loop.I_JUST, _loop.I_PENDING, _loop.I_WARN_C]] = -1
+    eta, deta = initial_coordinates(beam, initial, nm)
+    eta = np.ascontiguousarray(eta, dtype=float)
+    deta = np.ascontiguousarray(deta, dtype=float)
+    toggles = np.zeros(max(len(contactors), 1), dtype=np.int64)
+    rec = _Records(nm)
+    while True:
+        ic[_loop.I_NSLOTS] = pk.nslots
+        ic[_loop.I_NTR] = pk.ntr
+        status = _call(pk, con, pcs, options, tol_h, fc, ic, eta, deta, toggles, rec)
+        if status == _loop.NEED_STATE:
+            pk.add_state(int(ic[_loop.REQ_A]))
+        elif status == _loop.NEED_TRANSFER:
+            pk.add_transfer(int(ic[_loop.REQ_A]), int(ic[_loop.REQ_B]))
+        elif status == _loop.NEED_SPACE:
+            rec.grow(ic)
+        elif status == _loop.CHECKPOINT:
+            if progress is not None:
+                progress(float(fc[_loop.F_T]))
+        else:
+            break
+    if progress is not None:
+        progress(float(fc[_loop.F_T]))
+    return _solution(pk, contactors, options, pcs, con, fc, ic, rec, status)
 
-    if fast.supported(beam, contactors, damping, excitation, options, points, progress):
-        return fast.integrate_fast(beam, contactors, damping, excitation, initial, options, points)
-    integ = _Integrator(beam, contactors, damping, excitation, initial, options, points, progress)
-    eta, deta = initial_coordinates(beam, initial, options.modes)
-    return integ._run_from(eta, deta)
+
+def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solution:
+    nseg, nev, njump = int(ic[_loop.I_NSEG]), int(ic[_loop.I_NEV]), int(ic[_loop.I_NJUMP])
+    events = [
+        Event(float(rec.ev_t[i]), "impact" if rec.ev_kind[i] else "rebound", int(rec.ev_c[i]), float(rec.ev_v[i]))
+        for i in range(nev)
+    ]
+    t_stop = float(fc[_loop.F_T])
+    if status == _loop.CHATTER:
+        message = (
+            f"Stopped at t = {t_stop:.9g} s after {nev} events (solver.max_events or endless switching at one "
+            "instant): chattering contact; the solution ends there."
+        )
+        code = 1
+    else:
+        message = "The simulation reached end_time."
+        code = 0
+    warnings: list[str] = []
+    if ic[_loop.I_WARN_N]:
+        moved, scale = float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE])
+        warnings.append(
+            f"{int(ic[_loop.I_WARN_N])} of {njump} switches: the projection onto {options.modes} modes moved the "
+            f"deflection at a contactor by more than 5 % of its gap or deflection (worst: contactor "
+            f"{int(ic[_loop.I_WARN_C])} by {moved:.3g} m, {100 * moved / scale:.0f} %, at t = "
+            f"{float(fc[_loop.F_WARN_T]):.6g} s): the contactor is too stiff for this number of modes; add modes."
+        )
+    return Solution(
+        t0=rec.seg_t0[:nseg].copy(), t1=rec.seg_t1[:nseg].copy(), slot=rec.seg_s[:nseg].copy(),
+        piece=rec.seg_k[:nseg].copy(), eta0=rec.seg_eta[:nseg].copy(), deta0=rec.seg_deta[:nseg].copy(),
+        packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=events,
+        energy_jumps=rec.jumps[:njump].copy(), status=code, message=message, warnings=tuple(warnings),
+        t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
+        n_modes=options.modes,
+    )
+

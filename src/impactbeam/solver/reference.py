@@ -39,15 +39,17 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from ..beam import Beam, Contactor
 from ..exceptions import SimulationError
 from ..loading import Excitation, InitialCondition
-from .engine import Event, RawSolution, initial_coordinates
+from .engine import initial_coordinates
+from .solution import Event, PiecewiseSolution, Samples
 from .options import Damping, SolverOptions
 from .states import StateModel, StateSpace
 
-__all__ = ["integrate_ivp", "IvpSegment", "IvpDense", "RTOL"]
+__all__ = ["integrate_ivp", "IvpSegment", "IvpDense", "IvpSolution", "RTOL"]
 
 #: Relative tolerance of the reference integration.
 RTOL = 1e-10
@@ -57,8 +59,7 @@ class IvpDense:
     """Dense output of one ``solve_ivp`` run in one state, in the segment's local time.
 
     ``evaluate(tau)`` returns the modal displacement and velocity at
-    ``t0 + tau``, each of shape (n, p), like
-    :meth:`~impactbeam.solver.closed_form.ClosedFormSegment.evaluate`.
+    ``t0 + tau``, each of shape (n, p).
     """
 
     __slots__ = ("sol", "t0", "y0", "y1", "t1", "n")
@@ -151,20 +152,16 @@ class _Reference:
         damping: Damping,
         excitation: Excitation,
         options: SolverOptions,
-        points: np.ndarray,
     ) -> None:
         self.beam = beam
         self.contactors = contactors
         self.excitation = excitation
         self.opt = options
-        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, points)
+        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, np.zeros(0))
         self.gap = np.array([c.gap for c in contactors], dtype=float)
         self.side = np.array([c.direction for c in contactors], dtype=float)
         self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
         T = options.end_time
-        dt = options.time_step
-        self.n_out = int(math.floor(T / dt * (1.0 + 1e-12))) + 1
-        self.time = np.arange(self.n_out) * dt
         all_eng = tuple(range(len(contactors)))
         states = [self.space.state(())] + ([self.space.state(all_eng)] if contactors else [])
         wmax = max(st.omega_max for st in states)
@@ -218,7 +215,7 @@ class _Reference:
         return np.concatenate([np.full(n, a), np.full(n, a * w_ref)])
 
     # -------------------------------------------------------------- main loop
-    def run(self, eta: np.ndarray, deta: np.ndarray) -> RawSolution:
+    def run(self, eta: np.ndarray, deta: np.ndarray) -> IvpSolution:
         T = self.opt.end_time
         breaks = _load_breaks(self.excitation, T) + [T]
         engaged: tuple[int, ...] = ()
@@ -298,7 +295,7 @@ class _Reference:
                     events.pop()  # an impact and a rebound at one instant cancel (grazing touch)
                 else:
                     events.append(Event(t, kind, c, float(st.W_contact[c] @ deta)))
-                P = self.space.projection(new, engaged)
+                P = self.space.transfer(new, engaged, self.opt.projection == "contact")
                 eta, deta = P @ eta, P @ deta
                 engaged = new
                 jumps.append(self.energy(self.space.state(new), eta, deta) - E_before)
@@ -308,55 +305,108 @@ class _Reference:
                         f"contactor {c} switched {same_instant[c]} times at one instant")
                     message = (
                         f"Stopped at t = {t:.9g} s after {len(events)} events ({why}): "
-                        "chattering contact; later samples are NaN."
+                        "chattering contact; the solution ends there."
                     )
                     break
-        return self._sample(segments, events, jumps, status, message, t)
+        return IvpSolution(self, segments, events, np.asarray(jumps, dtype=float), status, message,
+                           t if status else T)
 
-    # -------------------------------------------------------------- output
-    def _sample(self, segments, events, jumps, status, message, t_reached) -> RawSolution:
-        n_out, nm = self.n_out, self.opt.modes
-        npnt, nc = self.space.points.size, len(self.contactors)
-        nan = lambda *s: np.full(s, np.nan)  # noqa: E731
-        w, w_t = nan(n_out, npnt), nan(n_out, npnt)
-        wc, wtc = nan(n_out, nc), nan(n_out, nc)
-        kin, strain, lpow, dpow = nan(n_out), nan(n_out), nan(n_out), nan(n_out)
-        eta_all, deta_all = nan(n_out, nm), nan(n_out, nm)
-        code = np.full(n_out, -1, dtype=np.int16)
-        keys: list[tuple[int, ...]] = []
-        T = self.opt.end_time
-        for j, seg in enumerate(segments):
-            last = j == len(segments) - 1
-            if last and status == 0:
-                sel = (self.time >= seg.t0) & (self.time <= T * (1 + 1e-12))
-            else:
-                sel = (self.time >= seg.t0) & (self.time < seg.t1)
-            idx = np.nonzero(sel)[0]
-            if idx.size == 0:
+
+
+class IvpSolution(PiecewiseSolution):
+    """Dense output of the ``solve_ivp`` path (see :class:`~impactbeam.solver.solution.PiecewiseSolution`).
+
+    Extrema are found on the DOP853 dense output sampled at 1/32 of the
+    shortest modal period and refined by Brent's method on the velocity;
+    integrals by 8-point Gauss-Legendre on sub-intervals of a quarter period.
+    """
+
+    def __init__(self, ref: _Reference, segments, events, jumps, status, message, t_end) -> None:
+        self.ref = ref
+        self.segments = segments
+        self.events = events
+        self.energy_jumps = jumps
+        self.status = status
+        self.message = message
+        self.warnings = ()
+        self.t_end = t_end
+        self.contactors = ref.contactors
+        self.n_modes = ref.opt.modes
+        self._t0 = np.array([seg.t0 for seg in segments])
+        self._h = ref.max_step / 8.0
+
+    def _index(self, t: np.ndarray) -> np.ndarray:
+        return np.clip(np.searchsorted(self._t0, t, side="right") - 1, 0, len(self.segments) - 1)
+
+    def sample(self, x, t, *, modal=False, energy=False) -> Samples:
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        nt, nm, nc = t.size, self.n_modes, len(self.contactors)
+        w, w_t = np.full((nt, x.size), np.nan), np.full((nt, x.size), np.nan)
+        eng = np.zeros((nt, nc), dtype=bool)
+        eta, eta_t, en = np.full((nt, nm), np.nan), np.full((nt, nm), np.nan), np.full((nt, 4), np.nan)
+        idx = self._index(t)
+        for j in np.unique(idx):
+            seg = self.segments[j]
+            sel = np.nonzero((idx == j) & (t <= self.t_end * (1 + 1e-15)))[0]
+            if sel.size == 0:
                 continue
-            st = self.space.state(seg.engaged)
-            if seg.engaged not in keys:
-                keys.append(seg.engaged)
-            tau = np.minimum(self.time[idx], seg.t1) - seg.t0
-            e, d = seg.solution.evaluate(tau)
-            n = e.shape[0]
-            w[idx] = (st.W_out @ e).T
-            w_t[idx] = (st.W_out @ d).T
-            if nc:
-                wc[idx] = (st.W_contact @ e).T
-                wtc[idx] = (st.W_contact @ d).T
-            code[idx] = keys.index(seg.engaged)
-            kin[idx] = 0.5 * np.sum(d**2, axis=0)
-            strain[idx] = 0.5 * np.sum((st.modes.omega[:, None] * e) ** 2, axis=0)
-            uu = self.excitation.history(self.time[idx])
-            lpow[idx] = uu * (st.load_weights @ d)
-            dpow[idx] = np.sum((2.0 * st.dyn.decay)[:, None] * d**2, axis=0)
-            eta_all[idx, :n] = e.T
-            deta_all[idx, :n] = d.T
-        return RawSolution(
-            self.time, w, w_t, wc, wtc, code, keys, kin, strain, lpow, dpow, eta_all, deta_all,
-            events, segments, self.space, status, message, jumps,
-        )
+            st = self.ref.space.state(seg.engaged)
+            e, d = seg.solution.evaluate(np.minimum(t[sel], seg.t1) - seg.t0)
+            W = st.modes.shapes(x)
+            w[sel] = (W.T @ e).T
+            w_t[sel] = (W.T @ d).T
+            eng[np.ix_(sel, list(seg.engaged))] = True
+            eta[sel], eta_t[sel] = e.T, d.T
+            if energy:
+                u = self.ref.excitation.history(t[sel])
+                en[sel, 0] = 0.5 * np.sum(d**2, axis=0)
+                en[sel, 1] = 0.5 * np.sum((st.modes.omega[:, None] * e) ** 2, axis=0)
+                en[sel, 2] = u * (st.load_weights @ d)
+                en[sel, 3] = np.sum((2.0 * st.dyn.decay)[:, None] * d**2, axis=0)
+        return Samples(w, w_t, eng, eta if modal else None, eta_t if modal else None, en if energy else None)
+
+    def _pieces(self, lo: float, hi: float, engaged: int | None):
+        for seg in self.segments:
+            a, b = max(seg.t0, lo), min(seg.t1, hi, self.t_end)
+            if b >= a and (engaged is None or engaged in seg.engaged):
+                yield seg, a, b
+
+    def extremum(self, x, lo, hi, sign=1.0, offset=0.0, engaged=None):
+        best, tbest = -np.inf, np.nan
+        for seg, a, b in self._pieces(lo, hi, engaged):
+            W = self.ref.space.state(seg.engaged).modes.shapes([x])[:, 0]
+
+            def u(tt, seg=seg, W=W):
+                e, d = seg.solution.evaluate(np.atleast_1d(tt) - seg.t0)
+                return sign * (W @ e + offset), sign * (W @ d)
+
+            ts = np.linspace(a, b, max(3, int(math.ceil((b - a) / self._h)) + 1))
+            val, der = u(ts)
+            k = int(np.argmax(val))
+            cand = [(float(val[k]), float(ts[k]))]
+            for i0, i1 in ((k - 1, k), (k, k + 1)):
+                if 0 <= i0 and i1 < ts.size and der[i0] > 0 > der[i1]:
+                    r = brentq(lambda tt: float(u(tt)[1][0]), ts[i0], ts[i1], xtol=1e-15)
+                    cand.append((float(u(r)[0][0]), float(r)))
+            v, tv = max(cand)
+            if v > best:
+                best, tbest = v, tv
+        return best, tbest
+
+    def integral(self, x, lo, hi):
+        gx, gw = np.polynomial.legendre.leggauss(8)
+        total = 0.0
+        for seg, a, b in self._pieces(lo, hi, None):
+            if b <= a:
+                continue
+            W = self.ref.space.state(seg.engaged).modes.shapes([x])[:, 0]
+            edges = np.linspace(a, b, max(2, int(math.ceil((b - a) / (2 * self._h))) + 1))
+            mid, half = 0.5 * (edges[1:] + edges[:-1]), 0.5 * np.diff(edges)
+            tt = (mid[:, None] + half[:, None] * gx[None, :]).ravel()
+            e, _ = seg.solution.evaluate(tt - seg.t0)
+            total += float(np.sum((W @ e).reshape(mid.size, 8) * gw[None, :] * half[:, None]))
+        return total
 
 
 def integrate_ivp(
@@ -366,8 +416,7 @@ def integrate_ivp(
     excitation: Excitation,
     initial: InitialCondition,
     options: SolverOptions,
-    points: np.ndarray,
-) -> RawSolution:
+) -> IvpSolution:
     """Integrate the modal model with :func:`scipy.integrate.solve_ivp` and terminal events.
 
     Parameters
@@ -381,17 +430,14 @@ def integrate_ivp(
     options : SolverOptions
         ``modes``, ``time_step`` (output sampling only), ``end_time``,
         ``max_events`` (chattering guard, status 1).
-    points : ndarray, (n_points,), [m]
-        Output positions.
 
     Returns
     -------
-    RawSolution
-        The same container as the exact solver's
-        :func:`~impactbeam.solver.engine.integrate`, with ``segments`` holding
-        :class:`IvpSegment` objects whose ``solution.evaluate`` wraps the
-        DOP853 dense output, so :class:`~impactbeam.result.SimulationResult`
-        and its metrics work unchanged.
+    IvpSolution
+        The dense output (the interface of the exact solver's
+        :class:`~impactbeam.solver.solution.Solution`), so
+        :class:`~impactbeam.result.SimulationResult` and its metrics work
+        unchanged.
 
     Raises
     ------
@@ -407,6 +453,6 @@ def integrate_ivp(
     and what is not (propagation, load evaluation, event detection and
     location).
     """
-    ref = _Reference(beam, tuple(contactors), damping, excitation, options, np.asarray(points, dtype=float))
+    ref = _Reference(beam, tuple(contactors), damping, excitation, options)
     eta, deta = initial_coordinates(beam, initial, options.modes)
     return ref.run(eta, deta)

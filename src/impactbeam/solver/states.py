@@ -15,10 +15,46 @@ import numpy as np
 from ..beam import Beam, Contactor
 from ..loading import Excitation, spatial_projection
 from ..modes import ModeSet, mode_set
-from .closed_form import ModalDynamics
 from .options import Damping
 
-__all__ = ["StateModel", "StateSpace"]
+__all__ = ["ModalDynamics", "StateModel", "StateSpace"]
+
+@dataclass(frozen=True, eq=False)
+class ModalDynamics:
+    """Frequencies and damping of the modes of one state, with regime masks.
+
+    ``decay = xi omega``; a mode is under-damped (``wd = omega sqrt(1 - xi^2)``),
+    over-damped (``wh = omega sqrt(xi^2 - 1)``) or critical, rigid-body modes
+    (``omega = 0``) counting as critical with zero decay.
+    """
+
+    omega: np.ndarray
+    xi: np.ndarray
+
+    @property
+    def decay(self) -> np.ndarray:
+        return self.xi * self.omega
+
+    @property
+    def _disc(self) -> np.ndarray:
+        return self.omega**2 * (1.0 - self.xi**2)
+
+    @property
+    def under(self) -> np.ndarray:
+        return self._disc > 0.0
+
+    @property
+    def over(self) -> np.ndarray:
+        return self._disc < 0.0
+
+    @property
+    def wd(self) -> np.ndarray:
+        return np.sqrt(np.where(self.under, self._disc, 0.0))
+
+    @property
+    def wh(self) -> np.ndarray:
+        return np.sqrt(np.where(self.over, -self._disc, 0.0))
+
 
 # State models are pure functions of their inputs (all immutable), so they are
 # shared between simulations: a parameter study that varies only the load or

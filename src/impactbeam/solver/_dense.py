@@ -1,0 +1,318 @@
+"""Compiled evaluation of the exact piecewise solution: samples, extrema and integrals.
+
+The solver records each segment's start time, state slot, load piece and
+modal state (:class:`~impactbeam.solver.solution.Solution`); these kernels
+rebuild a segment's closed form (:func:`~impactbeam.solver._closed.segment_setup`)
+and evaluate it.
+
+* :func:`sample` evaluates modal coordinates, deflections at given rows of
+  shapes, energies and powers at arbitrary times.
+* :func:`extremum` finds the maximum of ``sign (W eta + offset)`` over a time
+  interval by branch and bound: on a sub-interval with end values ``u0, u1``,
+  slopes ``d0, d1`` and the curvature bound ``M`` of
+  :func:`~impactbeam.solver._closed.curvature_bound`, no value exceeds
+  ``max(u0, u1, A(s_x))`` where ``A(s) = u0 + d0 s + M s^2/2`` meets its
+  mirror from the right end at ``s_x``; sub-intervals that cannot beat the
+  best value found (to ``atol``) are dropped, the others are split, and an
+  interior maximum (slope ``+`` to ``-``) is refined by Brent's method on the
+  velocity. The result is the maximum of the N-mode solution to ``atol``,
+  not of any sampled grid.
+* :func:`integral` integrates ``W eta`` in closed form
+  (:func:`~impactbeam.solver._closed.integral_of`), e.g. impulses.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ._closed import curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup, state_at
+from ._events import brent
+
+__all__ = ["sample", "extremum", "integral"]
+
+
+@njit(cache=True, nogil=True)
+def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, want_modal, want_energy,
+           seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, pw, Wc, smask, gap, side, kst,
+           pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+    """Evaluate the solution at times ``tq`` (segment ``segidx[i]`` each).
+
+    ``rows[s]`` (shape (S, r, n)) holds the shapes of state slot ``s`` at the
+    requested points; ``out_rows[i, j]`` and ``out_drows[i, j]`` receive
+    ``w`` and ``w_t`` there. With ``want_modal`` the modal coordinates go to
+    ``out_eta``/``out_deta``; with ``want_energy`` ``energies[i]`` receives
+    (kinetic, modal strain, external load power, damping power).
+    """
+    nm = seg_eta.shape[1]
+    h0 = np.empty(nm)
+    dh0 = np.empty(nm)
+    P = np.empty((nm, 7))
+    lA = np.empty(nm)
+    lB = np.empty(nm)
+    lD = np.empty(nm)
+    e = np.empty(nm)
+    d = np.empty(nm)
+    cur = -1
+    Om = 0.0
+    phi = 0.0
+    for i in range(tq.size):
+        j = segidx[i]
+        s = seg_s[j]
+        kp = seg_k[j]
+        if j != cur:
+            Om, phi = segment_setup(s, kp, seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, pw, Wc, smask,
+                                    gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD)
+            cur = j
+        tau = tq[i] - seg_t0[j]
+        state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, e, d)
+        for r in range(out_rows.shape[1]):
+            acc = 0.0
+            dacc = 0.0
+            for n in range(nm):
+                acc += rows[s, r, n] * e[n]
+                dacc += rows[s, r, n] * d[n]
+            out_rows[i, r] = acc
+            out_drows[i, r] = dacc
+        if want_modal:
+            out_eta[i, :] = e
+            out_deta[i, :] = d
+        if want_energy:
+            tp = tq[i] - pt0[kp]
+            u = pconst[kp] + pslope[kp] * tp
+            if pamp[kp] != 0.0:
+                u += pamp[kp] * math.sin(pOm[kp] * tp + pphase[kp])
+            kin = 0.0
+            strain = 0.0
+            lp = 0.0
+            dp = 0.0
+            for n in range(nm):
+                kin += d[n] * d[n]
+                strain += om[s, n] * om[s, n] * e[n] * e[n]
+                lp += pw[s, n] * u * d[n]
+                dp += 2.0 * dec[s, n] * d[n] * d[n]
+            energies[i, 0] = 0.5 * kin
+            energies[i, 1] = 0.5 * strain
+            energies[i, 2] = lp
+            energies[i, 3] = dp
+
+
+@njit(cache=True, nogil=True)
+def _upper(t0, u0, d0, t1, u1, d1, M):  # pragma: no cover - compiled
+    """Upper bound of a function on [t0, t1] from end values, slopes and ``|u''| <= M``."""
+    L = t1 - t0
+    U = max(u0, u1)
+    den = d0 - d1 + M * L
+    if den > 0.0:
+        sx = -(u0 - u1 + d1 * L - 0.5 * M * L * L) / den
+        if 0.0 < sx < L:
+            U = max(U, u0 + d0 * sx + 0.5 * M * sx * sx)
+    return U
+
+
+@njit(cache=True, nogil=True)
+def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
+    """Row 0 and its first two derivatives at ``tau`` (the second from the equation of motion)."""
+    p = PV[0]
+    u, du = particular(p, tau, Om, phi)
+    ddu = 2.0 * p[2] + 6.0 * p[3] * tau
+    if Om != 0.0:
+        th = Om * tau + phi
+        sn = math.sin(th)
+        cs = math.cos(th)
+        ddu += -Om * Om * (p[4] * sn + p[5] * cs) + p[6] * (-2.0 * Om * sn - Om * Om * tau * cs)
+    u += base[0]
+    for n in range(om.size):
+        eC, eS = kernel(reg[n], a[n], w[n], tau)
+        an = a[n]
+        o2 = om[n] * om[n]
+        vh = VH[0, n]
+        vd = VD[0, n]
+        u += (eC + an * eS) * vh + eS * vd
+        du += -o2 * eS * vh + (eC - an * eS) * vd
+        ddu += o2 * (an * eS - eC) * vh + ((2.0 * an * an - o2) * eS - 2.0 * an * eC) * vd
+    return u, du, ddu
+
+
+@njit(cache=True, nogil=True)
+def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
+    # pragma: no cover - compiled
+    """Branch and bound for the maximum of row 0 on ``[ta, tb]`` (module docstring).
+
+    ``M`` bounds ``|u''|`` and ``M3`` the third derivative: a sub-interval is
+    done when its upper bound cannot beat ``best``, when ``u`` is proven
+    monotone on it (the maximum is then at an end), or when ``u`` is proven
+    concave on it (``u'' < 0`` at both ends and ``|u''(t0)| + |u''(t1)| >= M3 L``;
+    the maximum is then the root of ``u'`` found by Brent's method, or an end).
+    Returns the new best value and its time, NaN when ``best`` was not beaten.
+    """
+    tbest = np.nan
+    ua, da, ca = _row3(ta, reg, a, w, om, VH, VD, base, PV, Om, phi)
+    ub, db, cb = _row3(tb, reg, a, w, om, VH, VD, base, PV, Om, phi)
+    if ua > best:
+        best = ua
+        tbest = ta
+    if ub > best:
+        best = ub
+        tbest = tb
+    stack[0, 0] = ta
+    stack[0, 1] = ua
+    stack[0, 2] = da
+    stack[0, 3] = ca
+    stack[0, 4] = tb
+    stack[0, 5] = ub
+    stack[0, 6] = db
+    stack[0, 7] = cb
+    top = 1
+    while top > 0:
+        top -= 1
+        t0 = stack[top, 0]
+        u0 = stack[top, 1]
+        d0 = stack[top, 2]
+        c0 = stack[top, 3]
+        t1 = stack[top, 4]
+        u1 = stack[top, 5]
+        d1 = stack[top, 6]
+        c1 = stack[top, 7]
+        L = t1 - t0
+        if _upper(t0, u0, d0, t1, u1, d1, M) <= best + atol or L <= xtol:
+            continue
+        if (d0 > 0.0 and d1 > 0.0 and d0 + d1 >= M * L) or (d0 < 0.0 and d1 < 0.0 and -(d0 + d1) >= M * L):
+            continue  # monotone: the ends hold the maximum
+        concave = c0 < 0.0 and c1 < 0.0 and -(c0 + c1) >= M3 * L
+        if concave and not (d0 > 0.0 and d1 < 0.0):
+            continue  # concave with no interior stationary point: the ends hold the maximum
+        tm = 0.5 * (t0 + t1)
+        if concave:  # the one interior maximum: Brent on u'
+            tm = brent(1, 0, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+            if not (t0 < tm < t1):
+                tm = 0.5 * (t0 + t1)
+        um, dm, cm = _row3(tm, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        if um > best:
+            best = um
+            tbest = tm
+        if concave or top + 2 > stack.shape[0]:
+            continue
+        stack[top, 0] = tm
+        stack[top, 1] = um
+        stack[top, 2] = dm
+        stack[top, 3] = cm
+        stack[top, 4] = t1
+        stack[top, 5] = u1
+        stack[top, 6] = d1
+        stack[top, 7] = c1
+        stack[top + 1, 0] = t0
+        stack[top + 1, 1] = u0
+        stack[top + 1, 2] = d0
+        stack[top + 1, 3] = c0
+        stack[top + 1, 4] = tm
+        stack[top + 1, 5] = um
+        stack[top + 1, 6] = dm
+        stack[top + 1, 7] = cm
+        top += 2
+    return best, tbest
+
+
+@njit(cache=True, nogil=True)
+def extremum(lo, hi, sign, offset, row, cond_bit, atol, xtol, Wr, out_val, out_t,
+             seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, pw, Wc, smask, gap, side, kst,
+             pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+    """Maxima of ``sign[q] (Wr[row[q], s] . eta + offset[q])`` over ``[lo[q], hi[q]]`` and their times.
+
+    Query ``q`` counts only segments whose state has contactor ``cond_bit[q]``
+    engaged (``cond_bit < 0``: all segments); ``(-inf, nan)`` when none qualifies.
+    """
+    nm = seg_eta.shape[1]
+    h0 = np.empty(nm)
+    dh0 = np.empty(nm)
+    P = np.empty((nm, 7))
+    lA = np.empty(nm)
+    lB = np.empty(nm)
+    lD = np.empty(nm)
+    V = np.empty((1, nm))
+    base = np.empty(1)
+    VH = np.empty((1, nm))
+    VD = np.empty((1, nm))
+    PV = np.empty((1, 7))
+    M = np.empty(1)
+    M3 = np.empty(1)
+    stack = np.empty((128, 8))
+    for q in range(lo.size):
+        best = -np.inf
+        tbest = np.nan
+        j0 = max(np.searchsorted(seg_t1, lo[q]) - 1, 0)
+        # a first lower bound from the segment starts inside the interval (no closed form needed)
+        for j in range(j0, seg_t0.size):
+            if seg_t0[j] > hi[q]:
+                break
+            s = seg_s[j]
+            if seg_t0[j] >= lo[q] and (cond_bit[q] < 0 or ((smask[s] >> cond_bit[q]) & 1) == 1):
+                v = 0.0
+                for n in range(nm):
+                    v += Wr[row[q], s, n] * seg_eta[j, n]
+                v = sign[q] * (v + offset[q])
+                if v > best:
+                    best = v
+                    tbest = seg_t0[j]
+        for j in range(j0, seg_t0.size):
+            if seg_t0[j] > hi[q]:
+                break
+            a0 = max(seg_t0[j], lo[q])
+            a1 = min(seg_t1[j], hi[q])
+            if a1 < a0:
+                continue
+            s = seg_s[j]
+            if cond_bit[q] >= 0 and ((smask[s] >> cond_bit[q]) & 1) == 0:
+                continue
+            Om, phi = segment_setup(s, seg_k[j], seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, pw, Wc,
+                                    smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
+                                    h0, dh0, P, lA, lB, lD)
+            for n in range(nm):
+                V[0, n] = sign[q] * Wr[row[q], s, n]
+            base[0] = sign[q] * offset[q]
+            project(V, base, h0, dh0, P, VH, VD, PV, 1)
+            curvature_bound(V, dec[s], om[s], h0, dh0, PV, Om, a1 - seg_t0[j], M)
+            jerk_bound(V, dec[s], om[s], h0, dh0, PV, Om, a1 - seg_t0[j], M3)
+            best, tloc = _segment_max(a0 - seg_t0[j], a1 - seg_t0[j], M[0], M3[0], best, atol, xtol,
+                                      stack, reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi)
+            if not np.isnan(tloc):
+                tbest = tloc + seg_t0[j]
+        out_val[q] = best
+        out_t[q] = tbest
+
+
+@njit(cache=True, nogil=True)
+def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, pw, Wc,
+             smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+    """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form."""
+    nm = seg_eta.shape[1]
+    h0 = np.empty(nm)
+    dh0 = np.empty(nm)
+    P = np.empty((nm, 7))
+    lA = np.empty(nm)
+    lB = np.empty(nm)
+    lD = np.empty(nm)
+    e = np.empty(nm)
+    d = np.empty(nm)
+    for q in range(lo.size):
+        total = 0.0
+        j0 = max(np.searchsorted(seg_t1, lo[q]) - 1, 0)
+        for j in range(j0, seg_t0.size):
+            if seg_t0[j] > hi[q]:
+                break
+            a0 = max(seg_t0[j], lo[q])
+            a1 = min(seg_t1[j], hi[q])
+            if a1 <= a0:
+                continue
+            s = seg_s[j]
+            Om, phi = segment_setup(s, seg_k[j], seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, pw, Wc,
+                                    smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
+                                    h0, dh0, P, lA, lB, lD)
+            if a0 > seg_t0[j]:  # restart the closed form at a0
+                state_at(a0 - seg_t0[j], reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, e, d)
+                Om, phi = segment_setup(s, seg_k[j], a0, e, d, reg, dec, om, pw, Wc, smask, gap, side, kst,
+                                        pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD)
+            total += integral_of(Wr[row[q], s], reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, a1 - a0)
+        out[q] = total

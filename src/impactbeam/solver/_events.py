@@ -1,0 +1,291 @@
+"""Compiled event location on the closed form: no crossing can be missed.
+
+The oriented opening of contactor ``c`` in the current state is
+``h_c(tau) = o_c (gap_c - s_c w(a_c, tau))`` (``o = +1`` free, ``-1``
+engaged), positive while the state is consistent. With a bound ``M_c`` on
+``|h_c''|`` over the segment (:func:`~impactbeam.solver._closed.curvature_bound`),
+Taylor's theorem gives, from any point with ``h > 0``,
+
+.. math:: h(\\tau + s) \\ge h + h' s - M s^2 / 2 > 0 \\quad\\text{for } s < s^* = \\frac{h' + \\sqrt{h'^2 + 2Mh}}{M},
+
+so the scan steps by ``s*`` (at least ``dmin``) and every step is either
+proven root-free from both of its ends, or subdivided until it is, or until a
+point with ``h <= 0`` is found; a sub-interval that starts positive, ends
+non-positive and on which ``h' < 0`` is proven (the same bound applied to
+``h'``) holds exactly one root, which Brent's method (SciPy's ``brentq``
+algorithm) locates to ``xtol``. Grazing dips of any depth above the touch
+tolerance are found this way, two crossings inside one step cannot be
+missed, and the scan does not depend on the output time step.
+
+A contactor left on the wrong side of its state by the projection of eq. (12)
+(``h < 0``, only for the contactor switched at the segment start, moving back
+towards its side) switches where its opening turns back, i.e. at the root
+of ``h'`` while ``h < 0``.
+
+Tangency at a segment start (``|h| <= tol_h``: zero gap at rest, a contactor
+just switched) is decided by the sign of the first derivative of ``h`` that
+is not zero up to round-off (:func:`departure`), computed exactly from the
+equation of motion, never by the sign of round-off in ``h`` itself.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ._closed import EPS, derivatives, kernel, particular
+
+__all__ = ["row_at", "brent", "safe_step", "first_event", "scan", "departure"]
+
+RTOL = 4.0 * EPS
+_STACK = 96
+
+
+@njit(cache=True, nogil=True)
+def row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
+    """``(h_c, h_c')`` of one row at ``tau``."""
+    pv, pd = particular(PV[c], tau, Om, phi)
+    g = base[c] + pv
+    dg = pd
+    for n in range(om.size):
+        eC, eS = kernel(reg[n], a[n], w[n], tau)
+        g += (eC + a[n] * eS) * VH[c, n] + eS * VD[c, n]
+        dg += -om[n] * om[n] * eS * VH[c, n] + (eC - a[n] * eS) * VD[c, n]
+    return g, dg
+
+
+@njit(cache=True, nogil=True)
+def _f(which, c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
+    g, dg = row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi)
+    return g if which == 0 else dg
+
+
+@njit(cache=True, nogil=True)
+def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover
+    """Root of ``h_c`` (which = 0) or ``h_c'`` (which = 1) in ``[xa, xb]`` bracketing a sign change.
+
+    SciPy's ``brentq`` algorithm (``xtol`` absolute, ``4 eps`` relative).
+    """
+    xpre = xa
+    xcur = xb
+    fpre = fa
+    fcur = fb
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    xblk = 0.0
+    fblk = 0.0
+    spre = 0.0
+    scur = 0.0
+    for _ in range(200):
+        if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
+            xblk = xpre
+            fblk = fpre
+            spre = xcur - xpre
+            scur = spre
+        if abs(fblk) < abs(fcur):
+            xpre = xcur
+            xcur = xblk
+            xblk = xpre
+            fpre = fcur
+            fcur = fblk
+            fblk = fpre
+        delta = (xtol + RTOL * abs(xcur)) / 2.0
+        sbis = (xblk - xcur) / 2.0
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre = scur
+                scur = stry
+            else:
+                spre = sbis
+                scur = sbis
+        else:
+            spre = sbis
+            scur = sbis
+        xpre = xcur
+        fpre = fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0.0 else -delta
+        fcur = _f(which, c, xcur, reg, a, w, om, VH, VD, base, PV, Om, phi)
+    return xcur
+
+
+@njit(cache=True, nogil=True)
+def safe_step(h, dh, M):  # pragma: no cover - compiled
+    """Largest ``s`` with ``h + dh s - M s^2/2 > 0`` (``h > 0``); inf if unbounded."""
+    if M <= 0.0:
+        return np.inf if dh >= 0.0 else h / (-dh)
+    q = math.sqrt(dh * dh + 2.0 * M * h)
+    if dh >= 0.0:
+        return (dh + q) / M
+    return 2.0 * h / (q - dh)
+
+
+@njit(cache=True, nogil=True)
+def _monotone(d0, d1, M, L, sign):  # pragma: no cover - compiled
+    """True when ``sign * h' > 0`` is proven on an interval of length L with end slopes d0, d1."""
+    s0 = sign * d0
+    s1 = sign * d1
+    if s0 <= 0.0 or s1 <= 0.0:
+        return False
+    return M <= 0.0 or (s0 + s1) >= M * L
+
+
+@njit(cache=True, nogil=True)
+def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
+    # pragma: no cover - compiled
+    """First switching time of row ``c`` in ``(ta, tb]``, or NaN (see the module docstring).
+
+    Values within ``tol_h`` of the surface count as touching: they are on the
+    consistent side (their departure was judged at the segment start), and a
+    dip that goes no deeper than ``tol_h`` is not an event.
+    """
+    top = 0
+    stack[0, 0] = ta
+    stack[0, 1] = ga
+    stack[0, 2] = dga
+    stack[0, 3] = tb
+    stack[0, 4] = gb
+    stack[0, 5] = dgb
+    top = 1
+    while top > 0:
+        top -= 1
+        t0 = stack[top, 0]
+        g0 = stack[top, 1]
+        d0 = stack[top, 2]
+        t1 = stack[top, 3]
+        g1 = stack[top, 4]
+        d1 = stack[top, 5]
+        L = t1 - t0
+        if g0 >= -tol_h:
+            touch0 = g0 <= tol_h
+            if g1 > 0.0 or (touch0 and g1 >= -tol_h):
+                # no event at the ends: prove that h stays above -tol_h inside
+                if M <= 0.0 or safe_step(g0 + tol_h, d0, M) + safe_step(g1 + tol_h, -d1, M) >= L:
+                    continue
+            elif not touch0 and (_monotone(d0, d1, M, L, -1.0) or L <= xtol):
+                return brent(0, c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+            elif touch0 and L <= xtol:
+                return t0  # from the surface straight into the stop
+            if L <= xtol:
+                continue  # a dip shallower than the touch tolerance
+        else:
+            # wrong side: switch where h' turns from + to - while h < 0 (moving further
+            # in, it stays: switching back and forth at one instant cannot help)
+            if _monotone(d0, d1, M, L, 1.0) or _monotone(d0, d1, M, L, -1.0):
+                continue  # monotone: no turn-back inside, at most an upward crossing
+            if d0 > 0.0 and d1 <= 0.0 and (L <= xtol or g1 <= 0.0):
+                r = brent(1, c, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+                gr, dr = row_at(c, r, reg, a, w, om, VH, VD, base, PV, Om, phi)
+                if gr <= 0.0:
+                    return r
+                # it rose above zero and came back: look for the downward crossing after r
+                stack[top, 0] = r
+                stack[top, 1] = gr
+                stack[top, 2] = dr
+                stack[top, 3] = t1
+                stack[top, 4] = g1
+                stack[top, 5] = d1
+                top += 1
+                continue
+            if L <= xtol:
+                continue
+        if top + 2 > stack.shape[0]:
+            continue  # deeper than the stack: the interval is below any resolvable scale
+        tm = 0.5 * (t0 + t1)
+        gm, dm = row_at(c, tm, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        stack[top, 0] = tm  # right half, examined after the left one
+        stack[top, 1] = gm
+        stack[top, 2] = dm
+        stack[top, 3] = t1
+        stack[top, 4] = g1
+        stack[top, 5] = d1
+        stack[top + 1, 0] = t0
+        stack[top + 1, 1] = g0
+        stack[top + 1, 2] = d0
+        stack[top + 1, 3] = tm
+        stack[top + 1, 4] = gm
+        stack[top + 1, 5] = dm
+        top += 2
+    return np.nan
+
+
+@njit(cache=True, nogil=True)
+def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
+    # pragma: no cover - compiled
+    """Advance from ``tau0`` to the first switching event before ``tau_end``.
+
+    ``g, dg`` hold the openings at ``tau0`` on entry. Returns ``(tau, c, n)``:
+    the event time and row, ``c = -1`` if none up to ``tau_end``, or ``c = -2``
+    when ``budget`` evaluations were spent first (``tau`` is then the point
+    reached, every row proven consistent up to it); ``n`` evaluations used.
+    """
+    nc = g.size
+    tau = tau0
+    used = 0
+    while tau < tau_end:
+        step = tau_end - tau
+        for c in range(nc):
+            if g[c] >= -tol_h:
+                s = safe_step(g[c] + tol_h, dg[c], M[c])
+            elif dg[c] > 0.0 and M[c] > 0.0:
+                s = dg[c] / M[c]
+            elif dg[c] > 0.0:
+                s = np.inf
+            else:
+                s = 0.0
+            if s < step:
+                step = s
+        step = min(max(step, dmin), tau_end - tau)
+        tb = tau + step
+        if tb <= tau:
+            tb = tau_end
+        for c in range(nc):
+            gb[c], dgb[c] = row_at(c, tb, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        used += 1
+        best = np.inf
+        which = -1
+        for c in range(nc):
+            r = first_event(c, tau, g[c], dg[c], tb, gb[c], dgb[c], M[c], xtol, tol_h, stack,
+                            reg, a, w, om, VH, VD, base, PV, Om, phi)
+            if not np.isnan(r) and r < best:
+                best = r
+                which = c
+        if which >= 0:
+            return best, which, used
+        tau = tb
+        for c in range(nc):
+            g[c] = gb[c]
+            dg[c] = dgb[c]
+        if used >= budget and tau < tau_end:
+            return tau, -2, used
+    return tau_end, -1, used
+
+
+@njit(cache=True, nogil=True)
+def departure(v, base, a, om, eta0, deta0, load_A, load_B, load_D, Om, phi, dvec, mag):  # pragma: no cover
+    """Sign (-1, 0, +1) of the first derivative of ``base + v eta`` at 0 that is not round-off.
+
+    A derivative counts as zero when it is below ``64 eps`` times the same sum
+    taken with absolute values (:func:`~impactbeam.solver._closed.derivatives`).
+    Orders 1 to ``dvec.size - 1`` are tried; 0 when all vanish (e.g. at rest).
+    """
+    kmax = dvec.size - 1
+    derivatives(v, base, a, om, eta0, deta0, load_A, load_B, load_D, Om, phi, kmax, dvec, mag)
+    for k in range(1, kmax + 1):
+        if abs(dvec[k]) > 64.0 * EPS * mag[k]:
+            return 1 if dvec[k] > 0.0 else -1
+    return 0

@@ -1,0 +1,240 @@
+"""Dense output of the solver: the exact piecewise modal solution and its events.
+
+Like SciPy's ``OdeSolution``, a solution is a list of segments, each with its
+own closed form; it can be evaluated at any time, not only at output
+samples. :class:`Solution` is what :func:`~impactbeam.solver.engine.integrate`
+returns; :class:`PiecewiseSolution` is the interface that
+:class:`~impactbeam.result.SimulationResult` and :mod:`~impactbeam.metrics`
+use, which the ``solve_ivp`` reference path implements too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..exceptions import ParameterError
+from . import _dense
+
+if TYPE_CHECKING:
+    from ..beam import Contactor
+
+__all__ = ["Event", "Samples", "PiecewiseSolution", "Solution"]
+
+
+@dataclass(frozen=True)
+class Event:
+    """An impact (contactor engages) or rebound (it releases) at an exact time.
+
+    Attributes
+    ----------
+    time : float, [s]
+    kind : {"impact", "rebound"}
+    contactor : int
+        Index of the contactor.
+    velocity : float, [m/s]
+        ``w_t`` at the contactor at the event.
+    """
+
+    time: float
+    kind: str
+    contactor: int
+    velocity: float
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """Values of a solution at given times (rows = times)."""
+
+    w: np.ndarray  # (n_t, n_x) [m]
+    w_t: np.ndarray  # (n_t, n_x) [m/s]
+    engaged: np.ndarray  # (n_t, n_c) bool
+    eta: np.ndarray | None = None  # (n_t, n_modes), basis of the state at each time
+    eta_t: np.ndarray | None = None
+    energies: np.ndarray | None = None  # (n_t, 4): kinetic, modal strain, load power, damping power
+
+
+class PiecewiseSolution:
+    """What every solution offers (the exact one and the ``solve_ivp`` reference).
+
+    Attributes
+    ----------
+    events : list of Event
+    status : int
+        0: reached ``end_time``; 1: stopped by the chattering guard.
+    message : str
+    warnings : tuple of str
+        What the solver is unsure of (e.g. a lossy projection at a switch).
+    energy_jumps : ndarray, [J]
+        Change of mechanical energy at each switch (zero for a lossless one).
+    t_end : float, [s]
+        Where the solution ends (``end_time`` unless stopped).
+    """
+
+    events: list[Event]
+    status: int
+    message: str
+    warnings: tuple[str, ...]
+    energy_jumps: np.ndarray
+    t_end: float
+    contactors: tuple[Contactor, ...]
+    n_modes: int
+
+    def check_times(self, t: Any, end_time: float, name: str = "t") -> np.ndarray:
+        """Times as a float array; ParameterError outside ``[0, end_time]``."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if t.ndim != 1:
+            raise ParameterError(f"{name}: expected a 1-D array of times, got shape {t.shape}")
+        bad = ~np.isfinite(t) | (t < 0.0) | (t > end_time * (1.0 + 1e-12))
+        if bad.any():
+            raise ParameterError(
+                f"{name}: {t[bad][0]:g} s is outside the simulated interval [0, {end_time:g}] s"
+            )
+        return t
+
+    def sample(self, x: np.ndarray, t: np.ndarray, *, modal: bool = False, energy: bool = False) -> Samples:
+        raise NotImplementedError
+
+    def extremum(self, x: float, lo: float, hi: float, sign: float = 1.0, offset: float = 0.0,
+                 engaged: int | None = None) -> tuple[float, float]:
+        """Maximum of ``sign (w(x, t) + offset)`` over ``[lo, hi]`` and its time.
+
+        With ``engaged = c`` only the times when contactor ``c`` is engaged count.
+        Returns ``(-inf, nan)`` when no time qualifies.
+        """
+        raise NotImplementedError
+
+    def integral(self, x: float, lo: float, hi: float) -> float:
+        """``int_lo^hi w(x, t) dt`` [m s]."""
+        raise NotImplementedError
+
+    def extrema(self, queries: list[tuple]) -> np.ndarray:
+        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged)``: array (n, 2)."""
+        return np.array([self.extremum(*q) for q in queries], dtype=float).reshape(len(queries), 2)
+
+    def integrals(self, queries: list[tuple[float, float, float]]) -> np.ndarray:
+        """Several :meth:`integral` queries ``(x, lo, hi)``."""
+        return np.array([self.integral(*q) for q in queries], dtype=float)
+
+
+class Solution(PiecewiseSolution):
+    """The exact piecewise solution of the N-mode model (closed form per segment).
+
+    Segment ``j`` covers ``[t0[j], t1[j]]`` in state slot ``slot[j]`` (the set
+    of engaged contactors ``engaged(j)``) under load piece ``piece[j]``,
+    starting from the modal state ``eta0[j], deta0[j]`` in that state's basis.
+    """
+
+    def __init__(self, *, t0, t1, slot, piece, eta0, deta0, packed, pieces, contactor_arrays, contactors,
+                 events, energy_jumps, status, message, warnings, t_end, evaluations, n_modes) -> None:
+        self.t0 = t0
+        self.t1 = t1
+        self.slot = slot
+        self.piece = piece
+        self.eta0 = eta0
+        self.deta0 = deta0
+        self.packed = packed
+        self.pieces = pieces
+        self.contactor_arrays = contactor_arrays
+        self.contactors = contactors
+        self.events = events
+        self.energy_jumps = energy_jumps
+        self.status = status
+        self.message = message
+        self.warnings = warnings
+        self.t_end = t_end
+        self.evaluations = evaluations
+        self.n_modes = n_modes
+        self._atol = 1e-12 * float(packed.space.beam.length)
+
+    @property
+    def n_segments(self) -> int:
+        return int(self.t0.size)
+
+    def engaged(self, j: int) -> tuple[int, ...]:
+        """Engaged contactors of segment ``j``."""
+        return self.packed.keys[int(self.slot[j])]
+
+    def _arrays(self) -> tuple:
+        pk = self.packed
+        return (pk.reg, pk.dec, pk.wdh, pk.om, pk.pw, pk.Wc, pk.smask, *self.contactor_arrays,
+                self.pieces[0], *self.pieces[2:])
+
+    def rows(self, x: np.ndarray) -> np.ndarray:
+        """Mode shapes of every visited state at ``x``: shape (n_states, len(x), n_modes)."""
+        return self.packed.rows(np.asarray(x, dtype=float))
+
+    def segment_index(self, t: np.ndarray) -> np.ndarray:
+        """Segment holding each time (an event time belongs to the segment it starts)."""
+        return np.clip(np.searchsorted(self.t0, t, side="right") - 1, 0, max(self.n_segments - 1, 0))
+
+    def sample(self, x: np.ndarray, t: np.ndarray, *, modal: bool = False, energy: bool = False) -> Samples:
+        """Exact values at times ``t`` (any order) and positions ``x``; NaN after ``t_end``."""
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        nt, nx, nm = t.size, x.size, self.n_modes
+        idx = self.segment_index(t)
+        w = np.empty((nt, nx))
+        w_t = np.empty((nt, nx))
+        eta = np.empty((nt, nm)) if modal else np.empty((0, nm))
+        eta_t = np.empty((nt, nm)) if modal else np.empty((0, nm))
+        en = np.empty((nt, 4)) if energy else np.empty((0, 4))
+        if nt and self.n_segments:
+            _dense.sample(t, idx, self.rows(x), w, w_t, eta, eta_t, en, modal, energy,
+                          self.t0, self.slot, self.piece, self.eta0, self.deta0, *self._arrays())
+        masks = self.packed.smask[self.slot[idx]] if self.n_segments else np.zeros(nt, dtype=np.int64)
+        nc = len(self.contactors)
+        engaged = ((masks[:, None] >> np.arange(nc)[None, :]) & 1).astype(bool)
+        after = t > self.t_end * (1.0 + 1e-15) if self.status else np.zeros(nt, dtype=bool)
+        if after.any() or not self.n_segments:
+            bad = after if self.n_segments else np.ones(nt, dtype=bool)
+            for arr in (w, w_t, eta if modal else None, eta_t if modal else None, en if energy else None):
+                if arr is not None:
+                    arr[bad] = np.nan
+        return Samples(w, w_t, engaged, eta if modal else None, eta_t if modal else None, en if energy else None)
+
+    def _row_table(self, xs: list[float]) -> tuple[np.ndarray, np.ndarray]:
+        """Distinct positions of ``xs`` with their shapes in every visited state, and each x's row."""
+        ux: dict[float, int] = {}
+        row = np.array([ux.setdefault(x, len(ux)) for x in xs], dtype=np.int64)
+        R = self.rows(np.fromiter(ux, dtype=float, count=len(ux)))  # (S, p, nm)
+        return np.ascontiguousarray(R.transpose(1, 0, 2)), row
+
+    def extrema(self, queries: list[tuple]) -> np.ndarray:
+        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged)`` at once: (n, 2)."""
+        n = len(queries)
+        out = np.empty((2, n))
+        out[0] = -np.inf
+        out[1] = np.nan
+        if n and self.n_segments:
+            Wr, row = self._row_table([q[0] for q in queries])
+            lo, hi, sign, offset, cond = (np.array(v) for v in zip(*(q[1:] for q in queries)))
+            cond = np.array([-1 if c is None else c for c in cond], dtype=np.int64)
+            _dense.extremum(
+                lo.astype(float), np.minimum(hi.astype(float), self.t_end), sign.astype(float),
+                offset.astype(float), row, cond, self._atol, 1e-14, Wr, out[0], out[1],
+                self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, *self._arrays(),
+            )
+        return out.T
+
+    def extremum(self, x: float, lo: float, hi: float, sign: float = 1.0, offset: float = 0.0,
+                 engaged: int | None = None) -> tuple[float, float]:
+        v, t = self.extrema([(x, lo, hi, sign, offset, engaged)])[0]
+        return float(v), float(t)
+
+    def integrals(self, queries: list[tuple[float, float, float]]) -> np.ndarray:
+        """Several :meth:`integral` queries ``(x, lo, hi)`` at once."""
+        n = len(queries)
+        out = np.zeros(n)
+        if n and self.n_segments:
+            Wr, row = self._row_table([q[0] for q in queries])
+            lo = np.array([q[1] for q in queries], dtype=float)
+            hi = np.minimum(np.array([q[2] for q in queries], dtype=float), self.t_end)
+            _dense.integral(lo, hi, row, Wr, out, self.t0, self.t1, self.slot, self.piece, self.eta0,
+                            self.deta0, *self._arrays())
+        return out
+
+    def integral(self, x: float, lo: float, hi: float) -> float:
+        return float(self.integrals([(x, lo, hi)])[0])
