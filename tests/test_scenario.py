@@ -590,3 +590,12 @@ def test_missing_scenario_file(tmp_path: Path) -> None:
     # Reason: a wrong path is a ScenarioError (exit 2 at the command line), not OSError.
     with pytest.raises(ScenarioError, match="file not found"):
         load_scenario(tmp_path / "nope.toml")
+
+
+def test_common_unit_table_agrees_with_pint():
+    # the table that spares the pint import must say what pint says, to the last bit
+    from impactbeam import units
+
+    for (unit, dimension), factor in units.COMMON_UNITS.items():
+        q = units._parse(unit, dimension)
+        assert units._quantity_to_si(q, unit, dimension) == factor, (unit, dimension)

@@ -49,8 +49,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.optimize import brentq
 
+from ._roots import brentq
 from .beam import Beam
 from .exceptions import ModeSolveError, ParameterError
 

@@ -36,6 +36,7 @@ __all__ = [
     "scale_decimal",
     "describe_dimension",
     "registry",
+    "COMMON_UNITS",
 ]
 
 #: Standard gravity [m/s^2] (the "g" of accelerations).
@@ -183,6 +184,38 @@ def _parse(text: str, dimension: str, shown: str | None = None) -> Any:
     return quantity
 
 
+#: SI factors of the units most scenario files use, so that reading them needs no
+#: pint registry (whose import and set-up cost a large part of a second). Every
+#: entry is checked against pint in the test suite; anything else goes to pint.
+COMMON_UNITS: dict[tuple[str, str], float] = {
+    **{(u, "length"): f for u, f in (("m", 1.0), ("mm", 1e-3), ("cm", 1e-2), ("um", 1e-6), ("km", 1e3))},
+    **{(u, "time"): f for u, f in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6))},
+    **{(u, "modulus"): f for u, f in (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9))},
+    **{(u, "density"): f for u, f in (("kg/m^3", 1.0), ("kg/m**3", 1.0))},
+    **{(u, "stiffness"): f for u, f in (("N/m", 1.0), ("kN/m", 1e3), ("N/mm", 1e3), ("MN/m", 1e6))},
+    **{(u, "force_per_length"): f for u, f in (("N/m", 1.0), ("kN/m", 1e3), ("N/mm", 1e3))},
+    **{(u, "force"): f for u, f in (("N", 1.0), ("kN", 1e3), ("mN", 1e-3))},
+    **{(u, "acceleration"): f for u, f in (("m/s^2", 1.0), ("m/s**2", 1.0), ("g", STANDARD_GRAVITY))},
+    **{(u, "area"): f for u, f in (("m^2", 1.0), ("mm^2", 1e-6))},
+    **{(u, "second_moment"): f for u, f in (("m^4", 1.0),)},
+    ("N*m/rad", "rotational_stiffness"): 1.0,
+}
+_FACTORS: dict[tuple[str, str], float] = {}
+
+
+def _unit_factor(unit: str, dimension: str, shown: str) -> float:
+    """SI factor of ``unit`` for ``dimension`` (table, then cache, then pint)."""
+    key = (unit, dimension)
+    hit = COMMON_UNITS.get(key)
+    if hit is None:
+        hit = _FACTORS.get(key)
+    if hit is None:
+        hit = _quantity_to_si(_parse(unit, dimension, shown), shown, dimension)
+        if len(_FACTORS) < 1024:
+            _FACTORS[key] = hit
+    return hit
+
+
 def _convert(value: Any, dimension: str) -> float:
     dim = _dimension(dimension)
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
@@ -219,7 +252,7 @@ def _convert(value: Any, dimension: str) -> float:
             m = _NUMBER_UNIT.match(text)
             if m is not None:
                 # "<number> <unit>": convert the unit alone, multiply in decimal (see scale_decimal)
-                factor = _quantity_to_si(_parse(m.group("unit"), dimension, text), text, dimension)
+                factor = _unit_factor(m.group("unit"), dimension, text)
                 number = m.group("number")
                 special = number.lower().lstrip("+-")
                 if special == "nan":
@@ -291,7 +324,7 @@ def unit_scale(unit: str, dimension: str, key: str) -> float:
     try:
         if not text:
             raise _UnitProblem(f"empty unit; expected {describe_dimension(dimension)}")
-        out = _quantity_to_si(_parse(text, dimension), text, dimension)
+        out = _unit_factor(text, dimension, text)
     except _UnitProblem as exc:
         raise ScenarioError(f"{key}: {exc}", key=key) from None
     if not (math.isfinite(out) and out != 0.0):
