@@ -110,3 +110,29 @@ def test_metrics_equal_at_every_output_step(dt):
     for key in ("max_response", "t_max", "first_impact_time", "free_duration", "contact_duration",
                 "min_response", "max_penetration", "n_impacts"):
         assert got[key] == pytest.approx(ref[key], rel=1e-9, abs=0.0), key
+
+
+def test_auto_modes_converge_and_report_the_change():
+    sc = ib.load_scenario(EXAMPLES / "case03.toml").with_values({"solver.modes": "auto", "solver.tolerance": 1e-3})
+    res = ib.simulate(sc)
+    assert res.n_modes in (8, 12, 16) and res.converged
+    assert max(res.convergence.values()) < 1e-3
+    # a fixed count is compared with a smaller one on request
+    fixed = ib.simulate(sc.with_values({"solver.modes": 8}))
+    assert set(fixed.convergence) == set(res.convergence) and fixed.converged
+
+
+def test_unconverged_fixed_count_warns():
+    # two modes cannot resolve the contact state of Case 3 to 1e-6
+    sc = ib.load_scenario(EXAMPLES / "case03.toml").with_values({"solver.modes": 2, "solver.tolerance": 1e-6})
+    res = ib.simulate(sc)
+    with pytest.warns(ib.ImpactBeamWarning, match="not converged in the number of modes"):
+        assert not res.converged
+    assert any("not converged" in w for w in res.warnings)
+
+
+@pytest.mark.parametrize("value, match", [("many", "solver.modes"), (0, "solver.modes"), (1.5, "solver.tolerance")])
+def test_bad_auto_settings(value, match):
+    key = "solver.tolerance" if match == "solver.tolerance" else "solver.modes"
+    with pytest.raises(ib.ParameterError, match=match):
+        ib.load_scenario(EXAMPLES / "case03.toml").with_values({key: value})

@@ -13,11 +13,13 @@ commands, so ``impactbeam --help`` stays fast.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import math
 import sys
-from collections.abc import Callable, Mapping
+import time
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -186,8 +188,8 @@ def _modes_table(sc: Any, ms: Any, free: list[float], contact: list[float] | Non
 @click.option("--out", "out", default=None, metavar="FILE",
               help="Write the full result (.nc, .csv or .parquet).")
 @click.option("--plot", "plot", default=None, metavar="FILE", help="Save a figure (e.g. .png, .pdf).")
-@click.option("--modes", "n_modes", type=int, default=None, metavar="N",
-              help="Override solver.modes (modes per state).")
+@click.option("--modes", "n_modes", default=None, metavar="N|auto",
+              help='Override solver.modes (modes per state, or "auto").')
 @click.option("--time-step", "time_step", default=None, metavar="DT",
               help='Override solver.time_step [s]; a unit is allowed ("10 us").')
 @click.option("--end-time", "end_time", default=None, metavar="T",
@@ -198,7 +200,7 @@ def simulate(
     as_json: bool,
     out: str | None,
     plot: str | None,
-    n_modes: int | None,
+    n_modes: str | None,
     time_step: str | None,
     end_time: str | None,
 ) -> None:
@@ -210,9 +212,12 @@ def simulate(
     """
     _check_output("--out", out, RESULT_SUFFIXES)
     _check_output("--plot", plot, PLOT_SUFFIXES)
+    modes: int | str | None = n_modes
+    if n_modes is not None and n_modes.strip().lstrip("+").isdigit():
+        modes = int(n_modes)
     sc = _load(
         scenario,
-        {"solver.modes": n_modes, "solver.time_step": time_step, "solver.end_time": end_time},
+        {"solver.modes": modes, "solver.time_step": time_step, "solver.end_time": end_time},
     )
     from .solver import simulate as run
 
@@ -222,8 +227,12 @@ def simulate(
     if plot is not None:
         from .plot import plot_result
 
-    result = run(sc)
+    with _progress(sc.solver.end_time) as report:
+        result = run(sc, progress=report)
     metrics = result.metrics()
+    metrics["modes"] = result.n_modes
+    metrics["convergence"] = result.convergence
+    metrics["warnings"] = list(result.warnings)
     if out is not None:
         try:
             write_result(result, out)
@@ -245,6 +254,29 @@ def simulate(
     for label, path in (("result", out), ("figure", plot)):
         if path is not None:
             click.echo(f"wrote {label} to {path}", err=True)
+
+
+@contextlib.contextmanager
+def _progress(end_time: float, after: float = 2.0) -> Iterator[Callable[[float], None]]:
+    """A progress callback that shows a bar on stderr once a run has taken ``after`` seconds."""
+    start = time.monotonic()
+    bar: Any = None
+
+    def report(t: float) -> None:
+        nonlocal bar
+        if bar is None and time.monotonic() - start > after:
+            from tqdm import tqdm
+
+            bar = tqdm(total=end_time, unit="s", unit_scale=True, desc="simulate", file=sys.stderr,
+                       bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s simulated [{elapsed}<{remaining}]")
+        if bar is not None:
+            bar.update(max(0.0, min(t, end_time) - bar.n))
+
+    try:
+        yield report
+    finally:
+        if bar is not None:
+            bar.close()
 
 
 def _number(value: Any) -> float | None:
@@ -308,6 +340,13 @@ def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
             )
         if len(events) > 20:
             lines.append(f"    ... {len(events) - 20} more (use --json for all)")
+    conv = metrics.get("convergence")
+    if conv:
+        key = max(conv, key=lambda k: conv[k])
+        lines.append(f"  modes: {metrics.get('modes')}; largest relative change against fewer modes: "
+                     f"{conv[key]:.2g} ({key})")
+    for text in metrics.get("warnings") or []:
+        lines.append(f"warning: {text}")
     return "\n".join(lines)
 
 

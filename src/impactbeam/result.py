@@ -8,6 +8,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -103,6 +104,8 @@ class SimulationResult:
     end_time: float
     scenario_name: str = "scenario"
     options: dict[str, Any] = field(default_factory=dict)
+    rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False)
+    tolerance: float = 2e-3
 
     # ------------------------------------------------------------------ from the solution
     @property
@@ -119,7 +122,51 @@ class SimulationResult:
 
     @property
     def warnings(self) -> tuple[str, ...]:
-        return tuple(self.solution.warnings)
+        """The solver's warnings, and the convergence warning once :attr:`convergence` is known."""
+        out = tuple(self.solution.warnings)
+        conv = self.__dict__.get("_convergence")
+        if conv is not None and not self.converged:
+            from .solver.convergence import worst
+
+            key, change = worst(conv)
+            out += (
+                f"not converged in the number of modes: with {self.n_modes} modes {key} still changes by "
+                f"{change:.2g} (relative; solver.tolerance = {self.tolerance:g}); use more modes or "
+                'solver.modes = "auto"',
+            )
+        return out
+
+    # ------------------------------------------------------------------ convergence in the modes
+    def set_convergence(self, changes: dict[str, float]) -> None:
+        """Record the relative change of the metrics against a smaller mode count."""
+        self.__dict__["_convergence"] = dict(changes)
+
+    @property
+    def convergence(self) -> dict[str, float] | None:
+        """Relative change of each Table-2 metric against a run with fewer modes.
+
+        For ``solver.modes = "auto"`` the change between the last two counts;
+        for a fixed count ``n`` computed on first access by a second run with
+        ``n - max(2, n // 4)`` modes (see :mod:`impactbeam.solver.convergence`).
+        None when it cannot be computed (one mode).
+        """
+        if "_convergence" not in self.__dict__:
+            from .exceptions import warn
+            from .solver.convergence import coarser_count, relative_changes
+
+            if self.rerun is None or self.n_modes <= 1:
+                return None
+            coarse = self.rerun(coarser_count(self.n_modes))
+            self.set_convergence(relative_changes(self.metrics(impacts=False), coarse.metrics(impacts=False)))
+            if not self.converged:
+                warn(self.warnings[-1])
+        return self.__dict__["_convergence"]
+
+    @property
+    def converged(self) -> bool:
+        """True when every convergence metric changes by less than ``solver.tolerance``."""
+        conv = self.convergence
+        return conv is not None and max(conv.values()) < self.tolerance
 
     @property
     def energy_jumps(self) -> np.ndarray:

@@ -128,7 +128,9 @@ _SCHEMA = _Table(
                 **_leaves("modal_displacement", "modal_velocity", list_ok=True, list_only=True),
             }
         ),
-        "solver": _Table(_leaves("modes", "time_step", "end_time", "max_events", "event_tolerance", "projection")),
+        "solver": _Table(
+            _leaves("modes", "time_step", "end_time", "max_events", "event_tolerance", "projection", "tolerance")
+        ),
         "output": _Table(_leaves("points", "point_ratios", list_ok=True, list_only=True)),
     }
 )
@@ -711,9 +713,14 @@ def _parse_initial(raw: Mapping[str, Any], beam: Beam) -> InitialCondition:
 def _parse_solver(raw: Mapping[str, Any]) -> SolverOptions:
     s = raw.get("solver", {})
     kw: dict[str, Any] = {}
-    for name in ("modes", "max_events"):
-        if name in s:
-            kw[name] = _integer(f"solver.{name}", s[name])
+    if isinstance(s.get("modes"), str) and s["modes"].strip().lower() == "auto":
+        kw["modes"] = "auto"
+    elif "modes" in s:
+        kw["modes"] = _integer("solver.modes", s["modes"])
+    if "max_events" in s:
+        kw["max_events"] = _integer("solver.max_events", s["max_events"])
+    if "tolerance" in s:
+        kw["tolerance"] = to_si(s["tolerance"], "dimensionless", "solver.tolerance")
     for name in ("time_step", "end_time", "event_tolerance"):
         if name in s:
             kw[name] = to_si(s[name], "time", f"solver.{name}")

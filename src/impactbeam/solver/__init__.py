@@ -5,6 +5,8 @@ The public entry point is :func:`simulate`.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Literal
 
@@ -13,6 +15,7 @@ import numpy as np
 from ..beam import Beam, Contactor
 from ..exceptions import ParameterError, warn
 from ..loading import Excitation, InitialCondition
+from .convergence import AUTO_COUNTS, relative_changes
 from .engine import integrate
 from .solution import Event, PiecewiseSolution, Solution
 from .options import Damping, SolverOptions
@@ -60,20 +63,44 @@ def simulate_system(
     if excitation.kind == "point_force" and excitation.position is not None and excitation.position > beam.length * (1 + 1e-12):
         raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
     _check_distinct(contactors)
-    if method == "ivp":
-        from .reference import integrate_ivp
-
-        solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, options)
-    elif method == "exact":
-        solution = integrate(beam, contactors, damping, excitation, initial, options, progress)
-    else:
+    if method not in ("exact", "ivp"):
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
-    for text in solution.warnings:
+
+    def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
+        opt = dataclasses.replace(options, modes=n_modes)
+        if method == "ivp":
+            from .reference import integrate_ivp
+
+            solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt)
+        else:
+            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress)
+        if announce:
+            for text in solution.warnings:
+                warn(text)
+        info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method}
+        return SimulationResult(solution, pts_arr, beam, contactors, n_modes, opt.time_step, opt.end_time, name,
+                                info, rerun=functools.partial(run, announce=False), tolerance=opt.tolerance)
+
+    if options.modes != "auto":
+        return run(int(options.modes))
+    return _auto_modes(run, options.tolerance)
+
+
+def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> SimulationResult:
+    """``solver.modes = "auto"``: add modes until the metrics change by less than ``tolerance``."""
+    prev = None
+    for n in AUTO_COUNTS:
+        res = run(n, announce=False)
+        m = res.metrics(impacts=False)
+        if prev is not None:
+            changes = relative_changes(m, prev)
+            res.set_convergence(changes)
+            if max(changes.values()) < tolerance:
+                break
+        prev = m
+    for text in res.warnings:
         warn(text)
-    opts = {"modes": options.modes, "time_step": options.time_step, "end_time": options.end_time, "method": method}
-    return SimulationResult(
-        solution, pts_arr, beam, contactors, options.modes, options.time_step, options.end_time, name, opts
-    )
+    return res
 
 
 def _check_distinct(contactors: tuple[Contactor, ...]) -> None:

@@ -18,6 +18,8 @@ study over those reuses every mode and transfer matrix.
 
 from __future__ import annotations
 
+import logging
+import os
 from collections import OrderedDict
 from collections.abc import Callable
 
@@ -33,6 +35,8 @@ from .states import StateModel, StateSpace
 
 __all__ = ["integrate", "initial_coordinates", "pack"]
 
+_LOG = logging.getLogger("impactbeam")
+_ANNOUNCED = False
 _BUDGET = 200_000  # evaluations of the closed form between checkpoints (~20-50 ms)
 _CACHE: OrderedDict[tuple, _Packed] = OrderedDict()
 _CACHE_SIZE = 64
@@ -56,6 +60,23 @@ def initial_coordinates(beam: Beam, initial: InitialCondition, n_modes: int) -> 
         v = np.asarray(initial.modal_velocity)
         deta[: min(v.size, deta.size)] += v[: deta.size]
     return eta, deta
+
+
+def kernels_cached() -> bool:
+    """Whether the compiled solver is in numba's disk cache (False: the next run compiles it)."""
+    try:
+        return os.path.exists(_loop.run._cache._cache_file._index_path)
+    except AttributeError:  # pragma: no cover - numba internals changed, or JIT disabled
+        return True
+
+
+def _announce_compile() -> None:
+    """Say once per process that the first run compiles the kernels (about 20 s on 2 cores)."""
+    global _ANNOUNCED
+    if not _ANNOUNCED and not kernels_cached():
+        _LOG.warning("impactbeam: compiling the solver for this machine (first use only, up to a minute on 2 cores); "
+                     "later runs load it from the cache")
+    _ANNOUNCED = True
 
 
 def _grow(a: np.ndarray, n: int) -> np.ndarray:
@@ -238,6 +259,7 @@ def integrate(
         The exact piecewise modal solution with its events.
     """
     contactors = tuple(contactors)
+    _announce_compile()
     pk = pack(beam, contactors, damping, excitation, options)
     nm = options.modes
     con = (

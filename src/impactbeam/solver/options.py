@@ -9,7 +9,10 @@ import numpy as np
 from .._validation import nonnegative_finite, positive_finite
 from ..exceptions import ParameterError
 
-__all__ = ["Damping", "SolverOptions"]
+__all__ = ["Damping", "SolverOptions", "MAX_MODES"]
+
+#: Largest number of modes per state (solver.modes, impactbeam modes --count).
+MAX_MODES = 200
 
 
 def _ratios(name: str, value: float | tuple[float, ...]) -> float | tuple[float, ...]:
@@ -53,8 +56,14 @@ class SolverOptions:
 
     Parameters
     ----------
-    modes : int
-        Number of modes kept in every state (rigid-body modes included).
+    modes : int or "auto"
+        Number of modes kept in every state (rigid-body modes included), or
+        ``"auto"``: add modes (4, 8, 12, 16, 24, 32, ...) until the Table-2
+        metrics change by less than ``tolerance`` between two counts
+        (:mod:`impactbeam.solver.convergence`).
+    tolerance : float
+        Relative change of the metrics that counts as converged (default 2e-3);
+        also the threshold of the unconverged warning for a fixed count.
     time_step : float, [s]
         Output sampling interval; also the scan interval for events (see the
         solver's Notes). The solution itself does not depend on it.
@@ -76,21 +85,27 @@ class SolverOptions:
         its gap.
     """
 
-    modes: int = 8
+    modes: int | str = 8
     time_step: float = 1e-5
     end_time: float = 0.2
     max_events: int = 10000
     event_tolerance: float = 1e-13
     projection: str = "paper"
+    tolerance: float = 2e-3
 
     def __post_init__(self) -> None:
         if self.projection not in ("contact", "paper"):
             raise ParameterError(f"solver.projection: must be 'contact' or 'paper', got {self.projection!r}")
-        if isinstance(self.modes, bool) or not isinstance(self.modes, (int, np.integer)) or self.modes < 1:
-            raise ParameterError(f"solver.modes: must be a positive integer, got {self.modes!r}")
-        if self.modes > 200:
-            raise ParameterError(f"solver.modes: at most 200 modes are supported, got {self.modes}")
-        object.__setattr__(self, "modes", int(self.modes))
+        if self.modes != "auto":
+            if isinstance(self.modes, bool) or not isinstance(self.modes, (int, np.integer)) or self.modes < 1:
+                raise ParameterError(f"solver.modes: must be a positive integer or 'auto', got {self.modes!r}")
+            if self.modes > MAX_MODES:
+                raise ParameterError(f"solver.modes: at most {MAX_MODES} modes are supported, got {self.modes}")
+            object.__setattr__(self, "modes", int(self.modes))
+        tol = positive_finite("solver.tolerance", self.tolerance)
+        if tol >= 1.0:
+            raise ParameterError(f"solver.tolerance: a relative change, expected below 1, got {tol:g}")
+        object.__setattr__(self, "tolerance", tol)
         object.__setattr__(self, "time_step", positive_finite("solver.time_step", self.time_step))
         object.__setattr__(self, "end_time", positive_finite("solver.end_time", self.end_time))
         if self.time_step > self.end_time:
