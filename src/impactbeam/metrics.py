@@ -75,23 +75,32 @@ def _metric_point(result: SimulationResult) -> tuple[float, float]:
 
 
 def compute_metrics(result: SimulationResult, *, impacts: bool = True) -> dict[str, Any]:
-    """The metrics dictionary of :meth:`SimulationResult.metrics`."""
+    """The metrics dictionary of :meth:`SimulationResult.metrics`.
+
+    All extrema of one call are found in one batch of the compiled kernel
+    (:meth:`~impactbeam.solver.solution.Solution.extrema`); with the
+    per-impact table, the minimum of ``u`` in a contact interval of the first
+    contactor is read from that interval's peak compression
+    (``u = -s w(a)`` there, so ``min u = -(peak compression + gap)``).
+    """
     sol = result.solution
     x, sign = _metric_point(result)
     t_end = sol.t_end
     out: dict[str, Any] = {k: None for k in METRIC_UNITS}
     out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
     out["n_events"] = len(result.events)
+    rows = _contact_rows(result) if impacts else []
     queries: list[tuple] = [(x, 0.0, t_end, sign, 0.0, None)]
     if result.contactors:
         c0 = result.contactors[0]
-        d = c0.direction
-        queries.append((c0.position, 0.0, t_end, d, -d * c0.gap, 0))
-    if not result.contactors:
+        queries.append((c0.position, 0.0, t_end, c0.direction, -c0.direction * c0.gap, 0))
+    else:
         queries.append((x, 0.0, t_end, -sign, 0.0, None))
+    queries += [_peak_query(result, ci, a, be) for ci, a, _, be in rows]
     ext = sol.extrema(queries)
     if not np.isfinite(ext[0, 0]):
-        out["impacts"] = [] if impacts else None
+        if impacts:
+            out["impacts"] = []
         return out
     out["max_response"] = float(ext[0, 0])
     t_max = float(ext[0, 1])
@@ -101,55 +110,73 @@ def compute_metrics(result: SimulationResult, *, impacts: bool = True) -> dict[s
         out["min_response"] = -float(ext[1, 0])
     else:
         out["max_penetration"] = max(float(ext[1, 0]), 0.0) if np.isfinite(ext[1, 0]) else 0.0
-        iv = contact_intervals(result, 0)
-        out["n_impacts"] = len(iv)
-        out["first_impact_time"] = iv[0][0] if iv else None
-        prev_end, nxt_start = 0.0, None
-        for a, b in iv:
-            if b <= t_max:
-                prev_end = b
-            elif a >= t_max:
-                nxt_start = a
-                break
-        out["free_duration"] = (nxt_start - prev_end) if nxt_start is not None else None
-        after = [(a, b) for a, b in iv if a >= t_max]
-        if after:
-            a, b = after[0]
-            if math.isfinite(b):
-                out["contact_duration"] = b - a
-            if a < t_end:
-                v, _ = sol.extremum(x, a, min(b, t_end), -sign, 0.0, None)
-                out["min_response"] = -float(v)
-    out["impacts"] = _impacts(result) if impacts else None
-    if not impacts:
-        del out["impacts"]
+        _contact_metrics(result, out, t_max, rows, ext[2:, 0])
+    if impacts:
+        out["impacts"] = _impact_table(result, rows, ext[2:, 0])
     return out
 
 
-def _impacts(result: SimulationResult) -> list[dict[str, Any]]:
+def _contact_metrics(result: SimulationResult, out: dict[str, Any], t_max: float, rows: list, peaks) -> None:
+    """Impact count, first impact, free and contact durations and the minimum in contact."""
+    sol = result.solution
+    c0 = result.contactors[0]
+    iv = contact_intervals(result, 0)
+    out["n_impacts"] = len(iv)
+    out["first_impact_time"] = iv[0][0] if iv else None
+    prev_end, nxt_start = 0.0, None
+    for a, b in iv:
+        if b <= t_max:
+            prev_end = b
+        elif a >= t_max:
+            nxt_start = a
+            break
+    out["free_duration"] = (nxt_start - prev_end) if nxt_start is not None else None
+    after = [(a, b) for a, b in iv if a >= t_max]
+    if not after:
+        return
+    a, b = after[0]
+    if math.isfinite(b):
+        out["contact_duration"] = b - a
+    if a >= sol.t_end:
+        return
+    known = [p for (ci, ra, _, _), p in zip(rows, peaks) if ci == 0 and ra == a]
+    if known and np.isfinite(known[0]):
+        out["min_response"] = -(float(known[0]) + c0.gap)
+    else:
+        x, sign = _metric_point(result)
+        v, _ = sol.extremum(x, a, min(b, sol.t_end), -sign, 0.0, None)
+        out["min_response"] = -float(v)
+
+
+def _contact_rows(result: SimulationResult) -> list[tuple[int, float, float, float]]:
+    """(contactor, start, end, end clipped to the solution) of every contact interval."""
+    t_end = result.solution.t_end
+    rows = []
+    for ci in range(len(result.contactors)):
+        for a, b in contact_intervals(result, ci):
+            if min(b, t_end) > a:
+                rows.append((ci, a, b, min(b, t_end)))
+    return rows
+
+
+def _peak_query(result: SimulationResult, ci: int, a: float, be: float) -> tuple:
+    """Extremum query for the largest compression ``s w(a) - gap`` of contactor ``ci`` on ``[a, be]``."""
+    c = result.contactors[ci]
+    return (c.position, a, be, c.direction, -c.direction * c.gap, ci)
+
+
+def _impact_table(result: SimulationResult, rows: list, peaks) -> list[dict[str, Any]]:
     """Duration, peak force and impulse of every contact interval (exact, closed form).
 
     The compression of contactor ``c`` is ``-g = s w(a) - gap``; the peak force
     is ``k`` times its maximum over the interval and the impulse ``k`` times
     its integral.
     """
-    sol = result.solution
-    rows = []
-    for ci, c in enumerate(result.contactors):
-        for a, b in contact_intervals(result, ci):
-            b_eff = min(b, sol.t_end)
-            if b_eff > a:
-                rows.append((ci, a, b, b_eff))
     if not rows:
         return []
-    ext = sol.extrema([
-        (result.contactors[ci].position, a, be, result.contactors[ci].direction,
-         -result.contactors[ci].direction * result.contactors[ci].gap, ci)
-        for ci, a, _, be in rows
-    ])
-    ints = sol.integrals([(result.contactors[ci].position, a, be) for ci, a, _, be in rows])
+    ints = result.solution.integrals([(result.contactors[ci].position, a, be) for ci, a, _, be in rows])
     out = []
-    for (ci, a, b, be), (peak, _), iw in zip(rows, ext, ints):
+    for (ci, a, b, be), peak, iw in zip(rows, peaks, ints):
         c = result.contactors[ci]
         out.append(
             {

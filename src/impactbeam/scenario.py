@@ -254,6 +254,8 @@ def _normalise(value: Any, path: str = "") -> Any:
     Tuples and arrays become lists, numpy scalars Python scalars, paths
     strings; keys whose value is None are dropped (None means "not given").
     """
+    if isinstance(value, (str, float, int)):  # immutable leaves (bool is an int): nothing to copy
+        return value
     if isinstance(value, Mapping):
         out = {}
         for key, sub in value.items():
