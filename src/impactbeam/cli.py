@@ -17,7 +17,9 @@ import contextlib
 import functools
 import json
 import math
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
@@ -111,7 +113,42 @@ def _check_output(option: str, path: str | None, suffixes: tuple[str, ...]) -> N
         raise ParameterError(f'{option}: directory "{p.parent}" does not exist')
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM (or SIGINT) received: the command stops, keeping finished work, exit 128 + signum."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(f"interrupted by signal {signum}")
+        self.signum = signum
+
+
+def _raise_interrupted(signum: int, frame: Any) -> None:
+    raise Interrupted(signum)
+
+
+class _Commands(click.Group):
+    """The command group: Ctrl-C exits 130 and SIGTERM 143, with one line, never a traceback."""
+
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        previous = None
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGTERM, _raise_interrupted)
+        try:
+            return super().main(*args, **kwargs)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            signum = int(getattr(exc, "signum", signal.SIGINT))
+            click.echo(f"interrupted ({signal.Signals(signum).name}): stopped; finished files are kept, "
+                       "nothing half-written", err=True)
+            sys.exit(128 + signum)
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="impactbeam", prog_name="impactbeam")
 def main() -> None:
     """Transient response of beams that impact stops (Xu & Ervin 2013, extended).

@@ -317,3 +317,19 @@ def jerk_bound(V, a, om, h0, dh0, PV, Om, tau_end, out):  # pragma: no cover - c
                 out[c] += abs(V[c, n]) * amp
     for c in range(out.size):
         out[c] *= 1.0 + 1e-12
+
+
+@njit(cache=True, nogil=True)
+def curvature_bound_at(tau, V, reg, a, w, om, h0, dh0, PV, Om, tau_end, out):  # pragma: no cover - compiled
+    """:func:`curvature_bound` valid on ``[tau, tau_end]``, from the homogeneous state at ``tau``.
+
+    The homogeneous energy only decreases, so the bound tightens as a damped
+    response decays; the scan refreshes it as it goes.
+    """
+    hh = np.empty(om.size)
+    dd = np.empty(om.size)
+    for n in range(om.size):
+        eC, eS = kernel(reg[n], a[n], w[n], tau)
+        hh[n] = (eC + a[n] * eS) * h0[n] + eS * dh0[n]
+        dd[n] = -om[n] * om[n] * eS * h0[n] + (eC - a[n] * eS) * dh0[n]
+    curvature_bound(V, a, om, hh, dd, PV, Om, tau_end, out)

@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._closed import EPS, derivatives, kernel, particular
+from ._closed import EPS, curvature_bound_at, derivatives, kernel, particular
 
 __all__ = ["row_at", "brent", "safe_step", "first_event", "scan", "departure"]
 
@@ -224,11 +224,14 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
 
 
 @njit(cache=True, nogil=True)
-def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
+def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg, a, w, om, VH, VD, base, PV, Om, phi,
+         V, h0, dh0):
     # pragma: no cover - compiled
     """Advance from ``tau0`` to the first switching event before ``tau_end``.
 
-    ``g, dg`` hold the openings at ``tau0`` on entry. Returns ``(tau, c, n)``:
+    ``g, dg`` hold the openings at ``tau0`` on entry; ``M`` their curvature
+    bounds, refreshed every 32 steps from the rows ``V`` and the homogeneous
+    initial values ``h0, dh0``. Returns ``(tau, c, n)``:
     the event time and row, ``c = -1`` if none up to ``tau_end``, or ``c = -2``
     when ``budget`` evaluations were spent first (``tau`` is then the point
     reached, every row proven consistent up to it); ``n`` evaluations used.
@@ -270,6 +273,8 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg
         for c in range(nc):
             g[c] = gb[c]
             dg[c] = dgb[c]
+        if used % 32 == 0:  # a decaying response earns longer steps
+            curvature_bound_at(tau, V, reg, a, w, om, h0, dh0, PV, Om, tau_end, M)
         if used >= budget and tau < tau_end:
             return tau, -2, used
     return tau_end, -1, used

@@ -242,7 +242,7 @@ def run(reg, dec, wdh, om, Wc, pw, smask, Tm, tr_from, tr_to, gap, side, kst,
             wmax = max(wmax, om[s, n])
         dmin = math.pi / (4.0 * wmax) if wmax > 0.0 else tau_end
         tau_e, ch, used = scan(0.0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget - evals, stack,
-                               reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi)
+                               reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi, V, h0, dh0)
         evals += used
         ic[I_EVALS] += used
         te = t + tau_e if ch != -1 else t_end
