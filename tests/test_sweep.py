@@ -475,3 +475,22 @@ def test_killed_sweep_resumes_to_the_uninterrupted_result(tmp_path):
 
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=120)  # complete: nothing to do
     assert again.returncode == 0 and f"0 computed, {N_KILL} already done" in again.stderr
+
+
+def test_one_writer_per_store(tmp_path):
+    """A second sweep on a store that another process is writing is refused, naming the holder."""
+    import json as _json
+    import socket
+
+    path = _write(tmp_path, "grid.toml", GRID)
+    out = tmp_path / "g.zarr"
+    lock = tmp_path / "g.zarr.lock"
+    # a live holder (this test's parent process) on this host
+    lock.write_text(_json.dumps({"pid": os.getppid(), "host": socket.gethostname(), "started": 0}))
+    with pytest.raises(ib.ParameterError, match=r"being written by another sweep \(pid \d+ on host"):
+        run_sweep(path, out, workers=0, progress=False)
+    assert not out.exists()
+    # a stale lock (its process is gone) is taken over, and released at the end
+    lock.write_text(_json.dumps({"pid": 2**22 + 12345, "host": socket.gethostname(), "started": 0}))
+    run = run_sweep(path, out, workers=0, progress=False)
+    assert run.computed == 12 and not lock.exists()

@@ -140,12 +140,12 @@ def _contact_metrics(result: SimulationResult, out: dict[str, Any], t_max: float
     if a >= sol.t_end:
         return
     known = [p for (ci, ra, _, _), p in zip(rows, peaks) if ci == 0 and ra == a]
-    if known and np.isfinite(known[0]):
-        out["min_response"] = -(float(known[0]) + c0.gap)
-    else:
-        x, sign = _metric_point(result)
-        v, _ = sol.extremum(x, a, min(b, sol.t_end), -sign, 0.0, None)
-        out["min_response"] = -float(v)
+    if known:
+        peak = float(known[0])
+    else:  # the same query as the per-impact table's, so both paths give the same bits
+        peak = float(sol.extrema([_peak_query(result, 0, a, min(b, sol.t_end))])[0, 0])
+    if np.isfinite(peak):
+        out["min_response"] = -(peak + c0.gap)
 
 
 def _contact_rows(result: SimulationResult) -> list[tuple[int, float, float, float]]:

@@ -49,6 +49,7 @@ interrupted and resumed sweep gives the same contents as an uninterrupted one.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import logging
@@ -59,6 +60,7 @@ import shutil
 import signal
 import sys
 import threading
+import time
 import tomllib
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
@@ -908,7 +910,12 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
 
 
 def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict[str, Any]]:
-    """The empty result (every case not run) as a lazy Dataset, and its Zarr encoding."""
+    """The empty result (every case not run) as a lazy Dataset, and its Zarr encoding.
+
+    Each variable is one lazy dask chunk (never computed: only the metadata
+    is written), so a sweep of millions of cases starts at once; the Zarr
+    encoding sets the on-disk chunks, one per batch.
+    """
     import dask.array as da
     import xarray as xr
 
@@ -936,11 +943,11 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
     data: dict[str, Any] = {}
     enc: dict[str, Any] = {}
     for m in spec.metrics:
-        data[m] = xr.Variable(dims, da.full(shape, np.nan, chunks=chunk), {"units": METRIC_UNITS[m], "long_name": m.replace("_", " ")})
+        data[m] = xr.Variable(dims, da.full(shape, np.nan, chunks=-1), {"units": METRIC_UNITS[m], "long_name": m.replace("_", " ")})
         enc[m] = {"chunks": chunk, "fill_value": np.nan}
     data["status"] = xr.Variable(
         dims,
-        da.full(shape, NOT_RUN, dtype=np.int8, chunks=chunk),
+        da.full(shape, NOT_RUN, dtype=np.int8, chunks=-1),
         {
             "long_name": "case status",
             "flag_values": list(STATUS_CODES),
@@ -948,7 +955,7 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
         },
     )
     enc["status"] = {"chunks": chunk, "fill_value": NOT_RUN}
-    data["message"] = xr.Variable(dims, da.full(shape, "", dtype=S, chunks=chunk), {"long_name": "error or solver message"})
+    data["message"] = xr.Variable(dims, da.full(shape, "", dtype=S, chunks=-1), {"long_name": "error or solver message"})
     enc["message"] = {"chunks": chunk}
     if spec.histories is not None:
         t = spec.history_times()
@@ -958,7 +965,7 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
         hchunk = (*chunk, t.size, pts.size)
         data["w"] = xr.Variable(
             (*dims, "time", "point"),
-            da.full((*shape, t.size, pts.size), np.nan, chunks=hchunk),
+            da.full((*shape, t.size, pts.size), np.nan, chunks=-1),
             {"units": "m", "long_name": "deflection w(x, t)"},
         )
         enc["w"] = {"chunks": hchunk, "fill_value": np.nan}
@@ -1145,19 +1152,101 @@ def run_sweep(
         raise ParameterError(f"batch_size: must be a positive integer, got {batch_size!r}")
     out_path = Path(out) if out is not None else None
     chunk = _chunk_shape(spec, batch_size or default_batch_size(spec.n_cases))
+    if out_path is None:
+        _check_in_memory(spec)
+    if out_path is not None and not out_path.parent.is_dir():
+        raise ParameterError(f'--out: directory "{out_path.parent}" does not exist')
+    with _StoreLock(out_path):
+        return _run_locked(spec, out_path, chunk, workers, scheduler, progress, on_error)
 
-    if out_path is not None and out_path.exists() and not (out_path.is_dir() and not any(out_path.iterdir())):
-        store = _open_existing(spec, out_path)
-    else:
-        if out_path is not None and not out_path.parent.is_dir():
-            raise ParameterError(f'--out: directory "{out_path.parent}" does not exist')
-        store = _create_store(spec, out_path, chunk)
+
+def _check_in_memory(spec: SweepSpec) -> None:
+    """Refuse, before any work, an in-memory result larger than the memory limit."""
+    from .result import check_memory
+
+    per_case = 8 * len(spec.metrics) + 40
+    if spec.histories is not None:
+        per_case += 8 * spec.history_times().size * len(spec.histories.points)
+    check_memory(per_case * spec.n_cases, f"an in-memory sweep of {spec.n_cases} cases",
+                 "write it to a store (out=...), or sweep fewer cases or histories")
+
+
+class _StoreLock:
+    """One writer per store: a lock file beside it with the holder's pid, host and start time.
+
+    A second run on the same store is refused with the holder's identity; a lock
+    left by a process of this host that no longer exists (killed) is stale and
+    is taken over.
+    """
+
+    def __init__(self, out: Path | None) -> None:
+        self.out = out
+        self.path = None if out is None else out.with_name(out.name + ".lock")
+
+    def __enter__(self) -> _StoreLock:
+        if self.path is None:
+            return self
+        import socket
+
+        me = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.time()}
+        for _ in range(3):
+            try:
+                fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                holder = self._holder()
+                if holder is not None and holder.get("host") == me["host"] and not _alive(holder.get("pid")):
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(self.path)  # stale: its process is gone
+                    continue
+                if holder is None:  # being written this very instant
+                    time.sleep(0.05)
+                    continue
+                when = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(float(holder.get("started", 0))))
+                raise ParameterError(
+                    f'--out: "{self.out}" is being written by another sweep (pid {holder.get("pid")} on host '
+                    f'{holder.get("host")}, since {when}); wait for it to finish, or remove "{self.path}" if '
+                    "that process is gone"
+                ) from None
+            with os.fdopen(fd, "w") as fh:
+                json.dump(me, fh)
+            return self
+        raise ParameterError(f'--out: cannot take the lock "{self.path}"')
+
+    def _holder(self) -> dict[str, Any] | None:
+        try:
+            return json.loads(Path(self.path).read_text())  # type: ignore[arg-type]
+        except (OSError, ValueError):
+            return None
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.path is not None:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(self.path)
+
+
+def _alive(pid: Any) -> bool:
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, TypeError, ValueError, OverflowError):
+        return True
+    return True
+
+
+def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], workers: int | None,
+                scheduler: str | None, progress: bool, on_error: str) -> SweepRun:
+    """:func:`run_sweep` once the store is ours."""
+    fresh = not (out_path is not None and out_path.exists()
+                 and not (out_path.is_dir() and not any(out_path.iterdir())))
+    store = _create_store(spec, out_path, chunk) if fresh else _open_existing(spec, out_path)  # type: ignore[arg-type]
     writer = _Writer(store, spec)
     chunk = tuple(writer.arrays["status"].chunks)  # the store's layout wins on resume
-    status = writer.status()
-    regions = [r for r in _regions(spec.shape, chunk) if (status[r] == NOT_RUN).any()]
+    # a new store has run nothing: no need to read its (possibly millions of) status chunks
+    status = np.full(spec.shape, NOT_RUN, dtype=np.int8) if fresh else writer.status()
+    regions = (r for r in _regions(spec.shape, chunk) if (status[r] == NOT_RUN).any())  # lazily
     skipped = int((status != NOT_RUN).sum())
-    n_todo = sum(int(np.prod([s.stop - s.start for s in r])) for r in regions)
+    n_todo = spec.n_cases - skipped
     counts = {"computed": 0, "failed": 0}
 
     from tqdm.auto import tqdm
@@ -1175,8 +1264,8 @@ def run_sweep(
 
     try:
         with _SignalGuard() as guard:
-            if regions:
-                batches = [_make_batch(spec, r, on_error) for r in regions]
+            if n_todo:
+                batches = (_make_batch(spec, r, on_error) for r in regions)
                 try:
                     if workers == 0:
                         for b in batches:
@@ -1232,7 +1321,7 @@ def _worker_config() -> dict[str, Any]:
 
 
 def _run_dask(
-    batches: list[_Batch], done: Any, *, workers: int | None, scheduler: str | None, on_error: str = "record"
+    batches: Iterator[_Batch], done: Any, *, workers: int | None, scheduler: str | None, on_error: str = "record"
 ) -> None:
     """Run the batches on a Dask cluster; ``done(region, result)`` as each finishes."""
     import dask
@@ -1258,12 +1347,31 @@ def _run_dask(
                     silence_logs=logging.ERROR,
                 )
             client = Client(cluster)
-        futures = client.map(run_batch, batches, pure=False)
-        region_of = {f.key: b.region for f, b in zip(futures, batches)}
+        # a bounded window of batches in flight: a sweep of any size starts at once, and
+        # an interrupt has only a few tasks to cancel
+        window = 4 * max(1, len(client.scheduler_info().get("workers", {})) or (workers or 1))
+        pending = iter(batches)
+        region_of: dict[Any, Any] = {}
+
+        def submit() -> Any:
+            b = next(pending, None)
+            if b is None:
+                return None
+            fut = client.submit(run_batch, b, pure=False)
+            region_of[fut.key] = b.region
+            futures.append(fut)
+            return fut
+
+        first = [f for f in (submit() for _ in range(window)) if f is not None]
+        queue = as_completed(first, with_results=True)
         try:
-            for fut, res in as_completed(futures, with_results=True):
-                done(region_of[fut.key], res)
+            for fut, res in queue:
+                done(region_of.pop(fut.key), res)
                 fut.release()
+                futures.remove(fut)
+                nxt = submit()
+                if nxt is not None:
+                    queue.add(nxt)
         except (ImpactBeamError, SweepInterrupted):
             raise
         except Exception as exc:
