@@ -68,3 +68,27 @@ def test_reproduce_stops_on_signal(tmp_path, sig, code):
     assert time.monotonic() - t0 < 5.0
     assert "Traceback" not in err
     assert not (out / "report.html").exists() and not (out / "report.md").exists()
+
+
+def test_memory_capped_run_is_refused_up_front(tmp_path):
+    # with a 2 GiB address-space limit, 20 s sampled at 1e-6 s with modal coordinates
+    # (~5 GB) must be refused with the estimate (exit 2), not crash allocating
+    sc = tmp_path / "c.toml"
+    sc.write_text((EXAMPLES / "case03.toml").read_text())
+    code = (
+        "import resource, sys; resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30));"
+        "from impactbeam.cli import main; sys.argv[0] = 'impactbeam'; main()"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code, "simulate", str(sc), "--end-time", "20", "--time-step", "1e-6",
+         "--out", str(tmp_path / "r.nc")], capture_output=True, text=True, timeout=300,
+    )
+    assert out.returncode == 2, out.stderr[-2000:]
+    assert "GiB, above the limit" in out.stderr and "Traceback" not in out.stderr
+    assert not (tmp_path / "r.nc").exists()
+
+
+def test_modes_count_is_capped():
+    out = subprocess.run([*CLI, "modes", str(EXAMPLES / "case03.toml"), "--count", "1000"], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 2 and "--count: expected 1 to 200 modes" in out.stderr

@@ -173,6 +173,10 @@ def modes(scenario: str, count: int | None, as_json: bool) -> None:
     The contact state has every contactor engaged; it is omitted without
     contactors.
     """
+    from .solver.options import MAX_MODES
+
+    if count is not None and not 1 <= count <= MAX_MODES:
+        raise ParameterError(f"--count: expected 1 to {MAX_MODES} modes (the limit of solver.modes), got {count}")
     if count is not None and count < 1:
         raise ParameterError(f"--count: must be a positive integer, got {count}")
     sc = _load(scenario)
@@ -260,7 +264,11 @@ def simulate(
 
     # import the writers before the (possibly long) run, so a broken install fails fast
     if out is not None:
-        from .result import write_result
+        from .result import check_output_size, write_result
+
+        n_t = int(math.floor(sc.solver.end_time / sc.solver.time_step * (1.0 + 1e-12))) + 1
+        n_m = 200 if sc.solver.modes == "auto" else int(sc.solver.modes)
+        check_output_size(n_t, len(sc.output_points), len(sc.contactors), n_m)  # before any work
     if plot is not None:
         from .plot import plot_result
 

@@ -22,26 +22,44 @@ if TYPE_CHECKING:
 
     from .solver.solution import Event, PiecewiseSolution
 
-__all__ = ["SimulationResult", "write_result", "RESULT_SUFFIXES", "memory_limit", "check_memory"]
+__all__ = [
+    "SimulationResult", "write_result", "RESULT_SUFFIXES", "memory_limit", "check_memory", "output_bytes",
+    "check_output_size",
+]
 
 RESULT_SUFFIXES = (".nc", ".csv", ".parquet")
 _CHUNK = 65536  # samples evaluated per call of the compiled sampler
 
 
 def memory_limit() -> int:
-    """Bytes a result may allocate for sampled histories (default 4 GiB).
+    """Bytes a request may allocate for sampled histories.
 
-    Set the environment variable ``IMPACTBEAM_MEMORY_LIMIT`` (bytes, or a
-    number with ``K``, ``M``, ``G`` suffix) to change it.
+    The smallest of: ``IMPACTBEAM_MEMORY_LIMIT`` (bytes, or a number with a
+    ``K``, ``M`` or ``G`` suffix; default 4 GiB), half of the machine's
+    physical memory, and 80 % of the process's address-space limit
+    (``ulimit -v``) when one is set.
     """
     raw = os.environ.get("IMPACTBEAM_MEMORY_LIMIT", "").strip().upper()
-    if not raw:
-        return 4 << 30
-    mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
+    limit = 4 << 30
+    if raw:
+        mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
+        try:
+            limit = int(float(raw.rstrip("KMGB") or "nan") * mult)
+        except ValueError:
+            raise ParameterError(f"IMPACTBEAM_MEMORY_LIMIT: not a size: {raw!r}") from None
     try:
-        return int(float(raw.rstrip("KMGB") or "nan") * mult)
-    except ValueError:
-        raise ParameterError(f"IMPACTBEAM_MEMORY_LIMIT: not a size: {raw!r}") from None
+        limit = min(limit, os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2)
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        pass
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft != resource.RLIM_INFINITY:
+            limit = min(limit, int(0.8 * soft))
+    except (ImportError, OSError, ValueError):  # pragma: no cover - not POSIX
+        pass
+    return limit
 
 
 def check_memory(nbytes: float, what: str, hint: str) -> None:
@@ -52,6 +70,28 @@ def check_memory(nbytes: float, what: str, hint: str) -> None:
             f"{what} would need {nbytes / 2**30:.3g} GiB, above the limit of {limit / 2**30:.3g} GiB; {hint} "
             "(or raise IMPACTBEAM_MEMORY_LIMIT)"
         )
+
+
+def output_bytes(n_times: int, n_points: int, n_contactors: int, n_modes: int, *, modal: bool = True) -> int:
+    """Estimated peak bytes of the sampled histories of a result and one copy of them.
+
+    ``w, w_t`` at the points and the contactors, contact forces and states,
+    and, with ``modal``, the modal coordinates and the seven energy series; the
+    factor 2 covers the copy a Dataset or DataFrame makes.
+    """
+    per = 8 * (2 * (n_points + n_contactors) + 2 * n_contactors) + n_contactors
+    if modal:
+        per += 8 * (2 * n_modes + 4 + 7)
+    return 2 * per * n_times
+
+
+def check_output_size(n_times: int, n_points: int, n_contactors: int, n_modes: int, modal: bool = True) -> None:
+    """Raise ResourceError, before any work, when :func:`output_bytes` exceeds :func:`memory_limit`."""
+    check_memory(
+        output_bytes(n_times, n_points, n_contactors, n_modes, modal=modal),
+        f"sampling {n_times} output times at {n_points} points" + (f" with {n_modes} modal coordinates" if modal else ""),
+        "use a larger solver.time_step, fewer output points or a shorter end_time",
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -188,11 +228,7 @@ class SimulationResult:
         t = self.time
         xs = np.concatenate([self.points, [c.position for c in self.contactors]])
         nm = self.n_modes
-        per = 8 * (2 * xs.size + len(self.contactors) + (2 * nm + 4 if modal else 0))
-        check_memory(
-            per * t.size, f"sampling {t.size} output times ({'modal coordinates, ' if modal else ''}"
-            f"{xs.size} points)", "use a larger solver.time_step, fewer output points or a shorter end_time",
-        )
+        check_output_size(t.size, self.points.size, len(self.contactors), nm, modal)
         out = {
             "w": np.empty((t.size, xs.size)), "w_t": np.empty((t.size, xs.size)),
             "engaged": np.empty((t.size, len(self.contactors)), dtype=bool),
@@ -426,6 +462,7 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     if suffix not in RESULT_SUFFIXES:
         raise ParameterError(f"--out: unsupported file type {suffix!r}; use one of {', '.join(RESULT_SUFFIXES)}")
     path.parent.mkdir(parents=True, exist_ok=True)
+    check_output_size(result.time.size, result.points.size, len(result.contactors), result.n_modes)
     with atomic_path(path) as tmp:
         if suffix == ".nc":
             ds = result.to_xarray()
