@@ -333,3 +333,9 @@ def curvature_bound_at(tau, V, reg, a, w, om, h0, dh0, PV, Om, tau_end, out):  #
         hh[n] = (eC + a[n] * eS) * h0[n] + eS * dh0[n]
         dd[n] = -om[n] * om[n] * eS * h0[n] + (eC - a[n] * eS) * dh0[n]
     curvature_bound(V, a, om, hh, dd, PV, Om, tau_end, out)
+
+
+@njit(cache=True, nogil=True)
+def workspace(nm):  # pragma: no cover - compiled
+    """Work arrays of :func:`segment_setup`: ``h0, dh0, P, lA, lB, lD`` for ``nm`` modes."""
+    return np.empty(nm), np.empty(nm), np.empty((nm, 7)), np.empty(nm), np.empty(nm), np.empty(nm)

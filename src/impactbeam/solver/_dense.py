@@ -28,7 +28,9 @@ import math
 import numpy as np
 from numba import njit
 
-from ._closed import curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup, state_at
+from ._closed import (
+    curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup, state_at, workspace,
+)
 from ._events import brent
 
 __all__ = ["sample", "extremum", "integral"]
@@ -47,12 +49,7 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
     (kinetic, modal strain, external load power, damping power).
     """
     nm = seg_eta.shape[1]
-    h0 = np.empty(nm)
-    dh0 = np.empty(nm)
-    P = np.empty((nm, 7))
-    lA = np.empty(nm)
-    lB = np.empty(nm)
-    lD = np.empty(nm)
+    h0, dh0, P, lA, lB, lD = workspace(nm)
     e = np.empty(nm)
     d = np.empty(nm)
     cur = -1
@@ -225,12 +222,7 @@ def extremum(lo, hi, sign, offset, row, cond_bit, atol, xtol, Wr, out_val, out_t
     engaged (``cond_bit < 0``: all segments); ``(-inf, nan)`` when none qualifies.
     """
     nm = seg_eta.shape[1]
-    h0 = np.empty(nm)
-    dh0 = np.empty(nm)
-    P = np.empty((nm, 7))
-    lA = np.empty(nm)
-    lB = np.empty(nm)
-    lD = np.empty(nm)
+    h0, dh0, P, lA, lB, lD = workspace(nm)
     V = np.empty((1, nm))
     base = np.empty(1)
     VH = np.empty((1, nm))
@@ -288,12 +280,7 @@ def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_de
              smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
     """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form."""
     nm = seg_eta.shape[1]
-    h0 = np.empty(nm)
-    dh0 = np.empty(nm)
-    P = np.empty((nm, 7))
-    lA = np.empty(nm)
-    lB = np.empty(nm)
-    lD = np.empty(nm)
+    h0, dh0, P, lA, lB, lD = workspace(nm)
     e = np.empty(nm)
     d = np.empty(nm)
     for q in range(lo.size):

@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._closed import curvature_bound, project, segment_setup, state_at
+from ._closed import curvature_bound, project, segment_setup, state_at, workspace
 from ._events import departure, scan
 
 DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
@@ -174,12 +174,7 @@ def run(reg, dec, wdh, om, Wc, pw, smask, Tm, tr_from, tr_to, gap, side, kst,
     """Run (or resume) the event loop; returns a status code (module docstring)."""
     nm = eta.size
     nc = gap.size
-    h0 = np.empty(nm)
-    dh0 = np.empty(nm)
-    P = np.empty((nm, 7))
-    lA = np.empty(nm)
-    lB = np.empty(nm)
-    lD = np.empty(nm)
+    h0, dh0, P, lA, lB, lD = workspace(nm)
     V = np.empty((nc, nm))
     base = np.empty(nc)
     VH = np.empty((nc, nm))
