@@ -565,7 +565,7 @@ def test_trace_error_names_file_and_line(tmp_path: Path) -> None:
     # Reason: a user must find the bad row in a long measured trace.
     (tmp_path / "t.csv").write_text("time,value\n0,0\n0.001,1\n0.0005,2\n", encoding="utf-8")
     text = BEAM + '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "t.csv"\n'
-    with pytest.raises(ScenarioError, match=r'^excitation\.file: "t\.csv" line 4: time 0\.0005 s'):
+    with pytest.raises(ScenarioError, match=r'^excitation\.file: "t\.csv" line 4, column 1 \(time\): time 0\.0005 s'):
         load_scenario(write(tmp_path, text))
 
 
