@@ -9,6 +9,7 @@ from importlib.metadata import PackageNotFoundError, version
 from .beam import Beam, Contactor, Support
 from .exceptions import (
     ImpactBeamError,
+    ImpactBeamWarning,
     ModeSolveError,
     ParameterError,
     ScenarioError,
@@ -43,6 +44,7 @@ __all__ = [
     "Event",
     "write_result",
     "ImpactBeamError",
+    "ImpactBeamWarning",
     "ParameterError",
     "ScenarioError",
     "ModeSolveError",

@@ -12,6 +12,7 @@ __all__ = [
     "ScenarioError",
     "ModeSolveError",
     "SimulationError",
+    "ImpactBeamWarning",
 ]
 
 
@@ -44,3 +45,15 @@ class ModeSolveError(ImpactBeamError, RuntimeError):
 
 class SimulationError(ImpactBeamError, RuntimeError):
     """The time integration could not be completed."""
+
+
+class ImpactBeamWarning(UserWarning):
+    """A result or an input that needs the user's attention, though not an error.
+
+    Emitted through :func:`impactbeam._warnings.emit_user_level_warning`, so
+    the warning points at the user's line, not at impactbeam's internals. The
+    command line collects them and prints each as ``warning: ...`` in its
+    summary and under ``"warnings"`` in ``--json`` output. Silence them with
+    ``warnings.filterwarnings("ignore", category=impactbeam.ImpactBeamWarning)``
+    or turn them into errors with ``"error"``.
+    """

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from ._atomic import write_text
+from ._checks import check_magnitudes, warn_numeric_strings, warn_unusual
 from ._textdata import numeric_columns, read_delimited
 from ._validation import choice, nonnegative_finite, positive_finite
 from .beam import SUPPORT_PRESETS, Beam, Contactor, Support
@@ -845,6 +846,8 @@ def parse_scenario(
         raise ScenarioError(f"a scenario must be a mapping of tables, got {type(data).__name__}")
     raw = _normalise(data)
     _check_structure(raw, _SCHEMA, "", raw)
+    check_magnitudes(raw)
+    warn_numeric_strings(raw)
     if "name" in raw:
         name = _string("name", raw["name"])
     if "description" in raw:
@@ -858,7 +861,7 @@ def parse_scenario(
     initial = _parse_initial(raw, beam)
     solver = _parse_solver(raw)
     points = _parse_output(raw, beam, contactors)
-    return Scenario(
+    scenario = Scenario(
         beam=beam,
         contactors=contactors,
         damping=damping,
@@ -871,6 +874,8 @@ def parse_scenario(
         base_dir=base,
         name=name,
     )
+    warn_unusual(scenario)
+    return scenario
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:

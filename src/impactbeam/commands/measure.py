@@ -15,7 +15,7 @@ from typing import Any
 
 import click
 
-from ..cli import PLOT_SUFFIXES, _check_output, _dumps, handle_errors
+from ..cli import PLOT_SUFFIXES, _check_output, _dumps, handle_errors, take_warnings, warning_lines
 from ..exceptions import ParameterError
 
 __all__ = ["COMMANDS", "identify", "compare", "fit"]
@@ -219,10 +219,11 @@ def identify(
                 data = set_path(data, path, value)
             dump_scenario(data, out)
             result["out"] = out
+    result["warnings"] = take_warnings()
     if as_json:
         click.echo(_dumps(result))
     else:
-        click.echo(_identify_text(result))
+        click.echo("\n".join([_identify_text(result), *warning_lines(result["warnings"])]))
     if out is not None:
         click.echo(f"wrote scenario to {out}", err=True)
 
@@ -304,13 +305,14 @@ def compare(
     cmp = run_compare(sc, meas, excitation=trace, hold=hold, point=x, window=win)  # type: ignore[arg-type]
     if plot is not None:
         cmp.plot(plot)
+    caught = take_warnings()
     if as_json:
         d = cmp.to_dict()
         d.update({"scenario": scenario, "measured": measured, "excitation": excitation,
-                  "hold": hold if excitation else None, "plot": plot})
+                  "hold": hold if excitation else None, "plot": plot, "warnings": caught})
         click.echo(_dumps(d))
     else:
-        click.echo(cmp.table())
+        click.echo("\n".join([cmp.table(), *warning_lines(caught)]))
     if plot is not None:
         click.echo(f"wrote figure to {plot}", err=True)
 
@@ -371,13 +373,14 @@ def fit(
     written: list[Path] = []
     if out is not None:
         written = res.write_scenario(out)
+    caught = take_warnings()
     if as_json:
         d = res.to_dict()
         d.update({"scenario": scenario, "measured": measured, "out": out,
-                  "written": [str(p) for p in written]})
+                  "written": [str(p) for p in written], "warnings": caught})
         click.echo(_dumps(d))
     else:
-        click.echo(res.report())
+        click.echo("\n".join([res.report(), *warning_lines(caught)]))
     for p in written:
         click.echo(f"wrote {p}", err=True)
 
