@@ -54,5 +54,6 @@ __all__ = [
 
 from .scenario import Scenario, load_scenario, parse_scenario
 from .sweep import sweep
+from .identification import Identification, identify
 
-__all__ += ["Scenario", "load_scenario", "parse_scenario", "sweep"]
+__all__ += ["Scenario", "load_scenario", "parse_scenario", "sweep", "identify", "Identification"]
