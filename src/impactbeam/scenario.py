@@ -583,13 +583,22 @@ def _parse_beam(raw: Mapping[str, Any]) -> Beam:
     )
 
 
+def _contact_stiffness(table: Mapping[str, Any], prefix: str) -> float:
+    """A contactor's stiffness: positive, finite or ``"inf"`` (a rigid stop)."""
+    key = _join(prefix, "stiffness")
+    k = to_si(table["stiffness"], "stiffness", key)
+    if not k > 0.0:
+        raise ScenarioError(f'{key}: must be positive ("inf" = rigid), got {k!r}', key=key)
+    return k
+
+
 def _parse_contactors(raw: Mapping[str, Any], beam: Beam) -> tuple[Contactor, ...]:
     out = []
     for i, c in enumerate(raw.get("contactors", [])):
         prefix = f"contactors.{i}"
         position = _position(c, prefix, beam.length, required=True)
         _required(c, prefix, "stiffness")
-        stiffness = _positive(c, prefix, "stiffness", "stiffness")
+        stiffness = _contact_stiffness(c, prefix)
         gap = _nonnegative(f"{prefix}.gap", c.get("gap", 0.0), "length")
         side = _choice(f"{prefix}.side", c.get("side", "below"), _SIDES)
         with _relabel(prefix, (("contactor.", f"{prefix}."),)):

@@ -5,6 +5,7 @@ The public entry point is :func:`simulate`.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Literal
 
@@ -48,6 +49,14 @@ def simulate_system(
     contactors = tuple(contactors)
     for i, c in enumerate(contactors):
         c.check_on(beam, f"contactors.{i}")
+        if np.isinf(c.stiffness):
+            k_ref = 3.0 * beam.bending_stiffness / beam.length**3
+            raise ParameterError(
+                f'contactors.{i}.stiffness: "inf" (a rigid stop) has contact-state modes (impactbeam modes) '
+                "but cannot be simulated: an impact on a rigid stop needs a restitution law the modal model "
+                f"does not have; give a finite stiffness (the stop's measured contact stiffness; for scale, "
+                f"3 E I / L^3 of this beam is {k_ref:.4g} N/m)"
+            )
     if points is None:
         pts = [c.position for c in contactors] + [beam.length]
         points = list(dict.fromkeys(pts))
@@ -68,6 +77,23 @@ def simulate_system(
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
     opts = {"modes": options.modes, "time_step": options.time_step, "end_time": options.end_time, "method": method}
     return SimulationResult.from_raw(raw, beam, contactors, pts_arr, options.modes, name, opts)
+
+
+def _require_scenario(scenario: object) -> None:
+    """TypeError for anything but a Scenario (a path, a dict), saying what to do."""
+    from ..scenario import Scenario
+
+    if isinstance(scenario, Scenario):
+        return
+    if isinstance(scenario, (str, os.PathLike)):
+        raise TypeError(
+            f"simulate: got the path {str(scenario)!r}; read it first: "
+            "impactbeam.simulate(impactbeam.load_scenario(path))"
+        )
+    raise TypeError(
+        f"simulate: expected a Scenario (from impactbeam.load_scenario or parse_scenario), got "
+        f"{type(scenario).__name__}; for a beam given as objects use impactbeam.simulate_system"
+    )
 
 
 def simulate(
@@ -93,6 +119,13 @@ def simulate(
     -------
     SimulationResult
 
+    Raises
+    ------
+    TypeError
+        When ``scenario`` is not a Scenario (e.g. a file path).
+    ParameterError
+        For a rigid contactor (``stiffness = inf``): give a finite stiffness.
+
     Notes
     -----
     The solution is exact for the truncated N-mode model: between events
@@ -113,6 +146,7 @@ def simulate(
     be missed; with the 1/8-period rule this needs a component faster than
     every retained mode.
     """
+    _require_scenario(scenario)
     return simulate_system(
         scenario.beam,
         scenario.contactors,
