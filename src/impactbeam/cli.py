@@ -144,6 +144,12 @@ def _check_output(option: str, path: str | None, suffixes: tuple[str, ...]) -> N
     if path is None:
         return
     p = Path(path)
+    if not path.strip():
+        raise ParameterError(f"{option}: the file name is empty (use {', '.join(suffixes)})")
+    if p.is_dir() or path.endswith(("/", "\\")):
+        raise ParameterError(
+            f'{option}: "{path}" is a directory; give a file name in it, e.g. "{p / ("result" + suffixes[0])}"'
+        )
     if p.suffix.lower() not in suffixes:
         raise ParameterError(
             f'{option}: unsupported file type "{p.suffix or p.name}" (use {", ".join(suffixes)})'

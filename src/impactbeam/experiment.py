@@ -1306,8 +1306,8 @@ class Comparison:
         :data:`FEATURES`; the difference is ``(sim - meas) / |meas|`` in percent.
     rms_difference : float, [m]
         RMS of ``w_sim - w_meas`` at the measured times.
-    nrmse : float
-        ``rms_difference / rms(w_meas)``.
+    nrmse : float or None
+        ``rms_difference / rms(w_meas)``; None when the measured rms is 0.
     """
 
     scenario: Scenario
@@ -1318,7 +1318,7 @@ class Comparison:
     sign: float
     features: dict[str, dict[str, float | None]]
     rms_difference: float
-    nrmse: float
+    nrmse: float | None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-Python summary (for JSON)."""
@@ -1341,7 +1341,8 @@ class Comparison:
             d = f["difference_percent"]
             rows.append((f"{label} [{unit}]", fmt(f["simulated"]), fmt(f["measured"]),
                          "n/a" if d is None else f"{d:+.2f} %"))
-        rows.append(("rms difference [mm]", f"{self.rms_difference * 1e3:.4f}", "", f"{self.nrmse * 100:.1f} % of rms"))
+        rel = "n/a (measured rms is 0)" if self.nrmse is None else f"{self.nrmse * 100:.1f} % of rms"
+        rows.append(("rms difference [mm]", f"{self.rms_difference * 1e3:.4f}", "", rel))
         widths = [max(len(r[j]) for r in rows) for j in range(4)]
         lines = [
             f"Comparison at x = {self.point * 1e3:.4g} mm (u = {'-w' if self.sign < 0 else 'w'}, "
@@ -1485,7 +1486,14 @@ def compare(
     diff = w_sim - meas.values
     rms = float(np.sqrt(np.mean(diff**2)))
     rms_m = float(np.sqrt(np.mean(meas.values**2)))
+    if float(np.ptp(meas.values)) <= 1e-12 * max(float(np.max(np.abs(meas.values))), 1e-300):
+        from ._warnings import emit_user_level_warning
+
+        emit_user_level_warning(
+            f"{meas.label}: the measured deflection is constant ({float(meas.values[0]):.6g} m) over the "
+            "compared window; the measured features are undefined and the comparison says little"
+        )
     return Comparison(
         scenario=sc, result=result, measured=meas, simulated=sim_rec, point=x, sign=sign,
-        features=feats, rms_difference=rms, nrmse=rms / rms_m if rms_m > 0 else math.inf,
+        features=feats, rms_difference=rms, nrmse=rms / rms_m if rms_m > 0 else None,
     )

@@ -899,13 +899,15 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
         For a missing or unreadable file, a TOML syntax error (with the
         parser's line and column) or invalid content.
     """
+    if not str(path).strip():
+        raise ScenarioError("cannot read scenario: the path is empty; give a scenario file (.toml)")
     p = Path(path)
     try:
         text = p.read_bytes().decode("utf-8")
     except FileNotFoundError:
         raise ScenarioError(f'cannot read scenario "{path}": file not found') from None
     except IsADirectoryError:
-        raise ScenarioError(f'cannot read scenario "{path}": it is a directory') from None
+        raise ScenarioError(f'cannot read scenario "{path}": it is a directory, not a scenario file (.toml)') from None
     except UnicodeDecodeError:
         raise ScenarioError(f'cannot read scenario "{path}": not UTF-8 text') from None
     except OSError as exc:
