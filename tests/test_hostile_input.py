@@ -14,11 +14,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_cli_input import BEAM, EXAMPLES, assert_one_error_line, run
 
 import impactbeam as ib
 from impactbeam.exceptions import ScenarioError
-
-from test_cli_input import BEAM, EXAMPLES, assert_one_error_line, run
 
 TRACE_SCENARIO = BEAM + '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "t.csv"\n'
 

@@ -13,11 +13,10 @@ import math
 from pathlib import Path
 
 import pytest
+from test_cli_input import assert_one_error_line, run
 
 import impactbeam as ib
 from impactbeam.exceptions import ParameterError
-
-from test_cli_input import assert_one_error_line, run
 
 PROP = """
 [beam]

@@ -571,10 +571,12 @@ def test_trace_error_names_file_and_line(tmp_path: Path) -> None:
 
 def test_parameter_error_from_data_class_is_relabelled() -> None:
     # Reason: a ParameterError raised inside a data class must come out led by the dotted key.
-    # Contactor itself rejects an infinite stiffness ("contactor.stiffness: ...").
+    # Contactor itself rejects a zero stiffness ("contactor.stiffness: ..."); "inf" (a rigid
+    # prop) is accepted since rigid contactors have contact-state modes (see test_rigid.py).
     with pytest.raises(ParameterError):
-        Contactor(0.05, math.inf)
-    data = tomllib.loads(BEAM + '[[contactors]]\nposition = 0.05\nstiffness = "inf"\n')
+        Contactor(0.05, 0.0)
+    assert Contactor(0.05, math.inf).rigid
+    data = tomllib.loads(BEAM + '[[contactors]]\nposition = 0.05\nstiffness = 0\n')
     with pytest.raises(ScenarioError, match=r"^contactors\.0\.stiffness: ") as info:
         parse_scenario(data)
     assert info.value.key == "contactors.0.stiffness"

@@ -47,7 +47,7 @@ time_step = 1e-4
 """
 
 # A 15 g, 15 ms half-sine pulse written every 0.5 ms (written numbers, exact decimals).
-MS = [Decimal(i) / 2 for i in range(0, 41)]
+MS = [Decimal(i) / 2 for i in range(41)]
 G = [Decimal(f"{15 * math.sin(math.pi * float(t) / 15):.6f}") if t <= 15 else Decimal(0) for t in MS]
 
 
@@ -91,7 +91,7 @@ def test_trace_in_ms_and_g_simulates_like_si(tmp_path: Path, header: str) -> Non
 
 def test_trace_and_record_read_the_same_numbers(tmp_path: Path) -> None:
     """The scenario trace and load_record give identical SI arrays from one file."""
-    _, user = _write_traces(tmp_path, "time,acceleration", "time (ms),acceleration (g)")
+    user = _write_traces(tmp_path, "time,acceleration", "time (ms),acceleration (g)")[1]
     (tmp_path / "user.toml").write_text(SCENARIO.format(file="user.csv"))
     sc = ib.load_scenario(tmp_path / "user.toml")
     rec = ex.load_record(user, resample=False)

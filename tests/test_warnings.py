@@ -13,12 +13,11 @@ import warnings
 from pathlib import Path
 
 import pytest
+from test_cli_input import BEAM, EXAMPLES, assert_one_error_line, run
 
 import impactbeam as ib
 from impactbeam._warnings import WarningLog, emit_user_level_warning
 from impactbeam.exceptions import ParameterError
-
-from test_cli_input import BEAM, EXAMPLES, assert_one_error_line, run
 
 CONTACTOR = '[[contactors]]\nposition_ratio = 0.484\nstiffness = 4030\ngap = 0.229e-3\nside = "above"\n'
 PULSE = '[excitation]\nkind = "base_acceleration"\namplitude = "15 g"\nduration = "15 ms"\n'
@@ -147,3 +146,26 @@ def test_cli_overrides_in_si_do_not_warn(tmp_path: Path) -> None:
     proc = run("simulate", EXAMPLES / "case03.toml", "--time-step", "1e-4", "--end-time", "0.01", "--json")
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout)["warnings"] == []
+
+
+def test_commands_that_do_not_report_warnings_print_them_on_stderr() -> None:
+    """handle_errors prints the ImpactBeamWarnings a command did not take (sweep, reproduce) on stderr."""
+    import click
+    from click.testing import CliRunner
+
+    from impactbeam.cli import handle_errors, take_warnings
+
+    @click.command()
+    @click.option("--take", is_flag=True)
+    @handle_errors
+    def cmd(take: bool) -> None:
+        emit_user_level_warning("solver.modes: a word")
+        if take:
+            click.echo(f"took {take_warnings()}")
+        click.echo("done")
+
+    res = CliRunner().invoke(cmd, [])
+    assert res.exit_code == 0 and res.stdout == "done\n"
+    assert res.stderr == "warning: solver.modes: a word\n"
+    res = CliRunner().invoke(cmd, ["--take"])
+    assert res.stdout == "took ['solver.modes: a word']\ndone\n" and res.stderr == ""

@@ -40,7 +40,7 @@ from .units import to_si
 if TYPE_CHECKING:
     from .scenario import Scenario
 
-__all__ = ["check_magnitudes", "warn_numeric_strings", "warn_unusual", "DERIVED_LIMIT", "STIFFNESS_RATIO_LIMIT"]
+__all__ = ["DERIVED_LIMIT", "STIFFNESS_RATIO_LIMIT", "check_magnitudes", "warn_numeric_strings", "warn_unusual"]
 
 #: Derived quantities (A, I, E I, rho A, omega_0) must lie in [1/limit, limit] (SI).
 DERIVED_LIMIT = 1e150

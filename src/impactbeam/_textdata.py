@@ -34,7 +34,7 @@ import numpy as np
 
 from .units import scale_decimal
 
-__all__ = ["read_data_lines", "DelimitedText", "read_delimited", "numeric_columns", "HEADER_CELL"]
+__all__ = ["HEADER_CELL", "DelimitedText", "numeric_columns", "read_data_lines", "read_delimited"]
 
 #: A header cell: a name and an optional unit in brackets or parentheses.
 HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\[\]()]*)[\])])?\s*$")

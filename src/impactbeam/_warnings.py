@@ -20,7 +20,7 @@ from typing import Any
 
 from .exceptions import ImpactBeamWarning
 
-__all__ = ["emit_user_level_warning", "WarningLog"]
+__all__ = ["WarningLog", "emit_user_level_warning"]
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 

@@ -35,7 +35,7 @@ import numpy as np
 
 from .exceptions import ParameterError
 
-__all__ = ["SineFit", "damping_sine_fit", "damping_matrix_pencil", "PENCIL_MAX_COLUMNS"]
+__all__ = ["PENCIL_MAX_COLUMNS", "SineFit", "damping_matrix_pencil", "damping_sine_fit"]
 
 #: Largest pencil parameter L (columns of the Hankel matrix); bounds the SVD cost on long records.
 PENCIL_MAX_COLUMNS = 400

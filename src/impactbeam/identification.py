@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from .experiment import DampingEstimate, FrequencyEstimate, Record
     from .scenario import Scenario
 
-__all__ = ["identify", "Identification", "ModeDamping", "MIN_OSCILLATION"]
+__all__ = ["MIN_OSCILLATION", "Identification", "ModeDamping", "identify"]
 
 #: A record whose detrended rms is below this fraction of its largest magnitude
 #: holds no oscillation (round-off of a constant is ~1e-16 of it).

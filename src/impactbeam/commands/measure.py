@@ -15,10 +15,17 @@ from typing import Any
 
 import click
 
-from ..cli import PLOT_SUFFIXES, _check_output, _dumps, handle_errors, take_warnings, warning_lines
+from ..cli import (
+    PLOT_SUFFIXES,
+    _check_output,
+    _dumps,
+    handle_errors,
+    take_warnings,
+    warning_lines,
+)
 from ..exceptions import ParameterError
 
-__all__ = ["COMMANDS", "identify", "compare", "fit"]
+__all__ = ["COMMANDS", "compare", "fit", "identify"]
 
 _RECORD_OPTIONS = [
     click.option("--time-unit", default=None, metavar="UNIT",
