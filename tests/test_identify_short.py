@@ -140,3 +140,20 @@ def test_identify_refuses_a_record_without_oscillation(tmp_path: Path, values: s
     assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0] and "flat.csv" in lines[0]
     with pytest.raises(ParameterError, match=needle):
         ib.identify(ex.load_record(p), 2)
+
+
+def test_fit_failure_falls_back_to_the_pencil_with_a_warning(short_decay, monkeypatch) -> None:
+    """A fit that does not converge is reported as n/a (None in JSON) with a warning, not as an error."""
+    import impactbeam.damping as dmp
+
+    def fail(*args, **kwargs):
+        raise ParameterError("damping fit: did not converge (test)")
+
+    monkeypatch.setattr(dmp, "damping_sine_fit", fail)
+    t, w, _ = short_decay
+    rec = ex.Record(t, w + np.random.default_rng(0).normal(0.0, NOISE, t.size))
+    with pytest.warns(ib.ImpactBeamWarning, match="damping from the matrix pencil only"):
+        ident = ib.identify(rec, 2)
+    d = ident.to_dict()
+    assert d["damping_ratios"] == [None, None] and d["damping_spread"] == [None, None]
+    assert abs(d["damping_matrix_pencil"][0] - XI) < 3e-4

@@ -131,3 +131,13 @@ def test_record_unit_error_names_file_column_and_unit(tmp_path: Path) -> None:
         ex.load_record(p)
     msg = str(info.value)
     assert "r.csv" in msg and "column 1" in msg and '"kg"' in msg
+
+
+def test_blank_separated_header_keeps_name_and_unit_together(tmp_path: Path) -> None:
+    """``time (ms)  acceleration (g)`` separated by blanks: two columns, units applied."""
+    p = tmp_path / "blank.txt"
+    p.write_text("time (ms)   acceleration (g)\n0 0\n0.5 1\n1.0 2\n")
+    (tmp_path / "b.toml").write_text(SCENARIO.format(file="blank.txt"))
+    sc = ib.load_scenario(tmp_path / "b.toml")
+    assert list(sc.excitation.times) == [0.0, 0.0005, 0.001]
+    assert sc.excitation.values[2] == 2 * STANDARD_GRAVITY

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._warnings import emit_user_level_warning
 from .exceptions import ParameterError
 
 if TYPE_CHECKING:
@@ -41,7 +42,8 @@ class ModeDamping:
     frequency_hz : float
         Spectral peak (damped frequency) [Hz].
     fit : float
-        Damped-sine least-squares estimate (the reported value).
+        Damped-sine least-squares estimate (the reported value; NaN, with a
+        warning, if the fit did not converge).
     fit_standard_error : float
         Its linearised standard error.
     pencil : float
@@ -96,10 +98,10 @@ class Identification:
             "sample_rate_hz": rec.sample_rate,
             "resolution_hz": self.frequencies.resolution_hz,
             "frequencies_hz": [float(f) for f in self.frequencies_hz],
-            "damping_ratios": [d.fit for d in self.damping],
-            "damping_standard_errors": [d.fit_standard_error for d in self.damping],
-            "damping_matrix_pencil": [None if math.isnan(d.pencil) else d.pencil for d in self.damping],
-            "damping_spread": [None if math.isnan(d.spread) else d.spread for d in self.damping],
+            "damping_ratios": [_finite_or_none(d.fit) for d in self.damping],
+            "damping_standard_errors": [_finite_or_none(d.fit_standard_error) for d in self.damping],
+            "damping_matrix_pencil": [_finite_or_none(d.pencil) for d in self.damping],
+            "damping_spread": [_finite_or_none(d.spread) for d in self.damping],
             "damping_log_decrement": [
                 None if d.log_decrement is None else d.log_decrement.damping_ratio for d in self.damping
             ],
@@ -126,12 +128,29 @@ def _require_oscillation(record: Record) -> None:
         )
 
 
+def _fit_values(fit: Any) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(fit.damping_ratios, dtype=float), np.asarray(fit.standard_errors, dtype=float)
+
+
+def _finite_or_none(x: float) -> float | None:
+    return x if math.isfinite(x) else None
+
+
 def _damping(record: Record, freqs: list[float]) -> tuple[ModeDamping, ...]:
     from .damping import damping_matrix_pencil, damping_sine_fit
     from .experiment import damping_log_decrement
 
-    fit = damping_sine_fit(record.time, record.values, freqs)
-    pencil, _ = damping_matrix_pencil(record.values, record.step, freqs)
+    nan = np.full(len(freqs), np.nan)
+    try:
+        fit_xi, fit_se = _fit_values(damping_sine_fit(record.time, record.values, freqs))
+    except ParameterError as exc:  # no convergence: report the other estimators, say why
+        emit_user_level_warning(f"{record.label}: no damped-sine fit ({exc}); damping from the matrix pencil only")
+        fit_xi, fit_se = nan, nan
+    try:
+        pencil, _ = damping_matrix_pencil(record.values, record.step, freqs)
+    except ParameterError as exc:
+        emit_user_level_warning(f"{record.label}: no matrix-pencil estimate ({exc})")
+        pencil = nan
     out = []
     for k, f in enumerate(freqs):
         logdec, note = None, None
@@ -140,7 +159,7 @@ def _damping(record: Record, freqs: list[float]) -> tuple[ModeDamping, ...]:
         except ParameterError as exc:
             note = str(exc).split(": ", 1)[-1]
         out.append(ModeDamping(
-            frequency_hz=f, fit=float(fit.damping_ratios[k]), fit_standard_error=float(fit.standard_errors[k]),
+            frequency_hz=f, fit=float(fit_xi[k]), fit_standard_error=float(fit_se[k]),
             pencil=float(pencil[k]), log_decrement=logdec, log_decrement_note=note,
         ))
     return tuple(out)

@@ -199,7 +199,8 @@ def _identify_text(r: dict[str, Any]) -> str:
         "  mode  frequency [Hz]       fit [%]  pencil [%]  spread [%]   log decrement [%] (cycles)",
     ]
     for i, f in enumerate(r["frequencies_hz"]):
-        fit = f"{_pct(r['damping_ratios'][i])} +/- {_pct(r['damping_standard_errors'][i])}"
+        fit = "n/a" if r["damping_ratios"][i] is None else (
+            f"{_pct(r['damping_ratios'][i])} +/- {_pct(r['damping_standard_errors'][i])}")
         ld = r["damping_log_decrement"][i]
         ldt = "n/a" if ld is None else (
             f"{_pct(ld)} +/- {_pct(r['damping_cycle_spread'][i])} ({r['damping_cycles'][i]})")
