@@ -302,7 +302,7 @@ BAD_RECORDS = {
     "non_numeric": ("time,deflection\n" + "\n".join(f"{i},{i}" for i in range(5)) + "\n5,abc\n6,1\n7,1\n8,1",
                     "line 7, column 2 (deflection): cannot read 'abc'"),
     "non_increasing": ("time,deflection\n" + "\n".join(f"{i},{i}" for i in range(5)) + "\n3,1\n6,1\n7,1\n8,1",
-                       "line 7, column 1 (time): time 3 does not come after the previous 4"),
+                       "line 7, column 1 (time): time 3 s does not come after the previous 4 s"),
     "nan": ("time,deflection\n" + "\n".join(f"{i},{i}" for i in range(5)) + "\n5,nan\n6,1\n7,1\n8,1",
             "line 7, column 2 (deflection): NaN value"),
     "too_short": ("time,deflection\n0,0\n1,1\n2,2", "at least 8"),

@@ -565,16 +565,18 @@ def test_trace_error_names_file_and_line(tmp_path: Path) -> None:
     # Reason: a user must find the bad row in a long measured trace.
     (tmp_path / "t.csv").write_text("time,value\n0,0\n0.001,1\n0.0005,2\n", encoding="utf-8")
     text = BEAM + '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "t.csv"\n'
-    with pytest.raises(ScenarioError, match=r'^excitation\.file: "t\.csv" line 4: time 0\.0005 s'):
+    with pytest.raises(ScenarioError, match=r'^excitation\.file: "t\.csv" line 4, column 1 \(time\): time 0\.0005 s'):
         load_scenario(write(tmp_path, text))
 
 
 def test_parameter_error_from_data_class_is_relabelled() -> None:
     # Reason: a ParameterError raised inside a data class must come out led by the dotted key.
-    # Contactor itself rejects an infinite stiffness ("contactor.stiffness: ...").
+    # Contactor itself rejects a zero stiffness ("contactor.stiffness: ..."); "inf" (a rigid
+    # prop) is accepted since rigid contactors have contact-state modes (see test_rigid.py).
     with pytest.raises(ParameterError):
-        Contactor(0.05, math.inf)
-    data = tomllib.loads(BEAM + '[[contactors]]\nposition = 0.05\nstiffness = "inf"\n')
+        Contactor(0.05, 0.0)
+    assert Contactor(0.05, math.inf).rigid
+    data = tomllib.loads(BEAM + '[[contactors]]\nposition = 0.05\nstiffness = 0\n')
     with pytest.raises(ScenarioError, match=r"^contactors\.0\.stiffness: ") as info:
         parse_scenario(data)
     assert info.value.key == "contactors.0.stiffness"

@@ -41,6 +41,8 @@ _EXPORTS: dict[str, str] = {
     "Scenario": "scenario",
     "load_scenario": "scenario",
     "parse_scenario": "scenario",
+    "identify": "identification",
+    "Identification": "identification",
 }
 
 __all__ = [*_EXPORTS, "modes", "sweep", "__version__"]
@@ -61,6 +63,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .result import SimulationResult, write_result
     from .scenario import Scenario, load_scenario, parse_scenario
     from .solver import Damping, Event, SolverOptions, simulate, simulate_system
+    from .identification import Identification, identify
     from .sweep import sweep
 
 

@@ -1,12 +1,45 @@
-"""Reading delimited text data (scenario traces, measured records)."""
+"""Reading delimited text data: the one reader of scenario traces and measured records.
+
+Both an excitation trace (``[excitation] shape = "table"``, read by
+:func:`impactbeam.scenario.read_table`) and a measured record
+(:func:`impactbeam.experiment.load_record`) are text tables read here, so
+they accept the same layout:
+
+* cells separated by commas, or semicolons, or tabs (the first of these that
+  occurs), else by blanks;
+* blank lines and lines starting with ``#`` skipped;
+* an optional header line naming the columns, each with an optional unit in
+  brackets or parentheses: ``time [ms],acceleration [g]`` or
+  ``time (ms),acceleration (g)``; a column without a unit is SI.
+
+The caller decides what a unit means for each column (a time, an
+acceleration, a length) and passes the resulting SI factors to
+:func:`numeric_columns`, which scales each written number in decimal
+arithmetic (:func:`impactbeam.units.scale_decimal`), so ``1.5`` in a
+``time (ms)`` column gives exactly the float ``0.0015``.
+"""
 
 from __future__ import annotations
 
+import csv
+import io
+import math
 import os
-from collections.abc import Callable
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["read_data_lines"]
+import numpy as np
+
+from .units import scale_decimal
+
+__all__ = ["HEADER_CELL", "DelimitedText", "numeric_columns", "read_data_lines", "read_delimited"]
+
+#: A header cell: a name and an optional unit in brackets or parentheses.
+HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\[\]()]*)[\])])?\s*$")
+
+_BLANK_HEADER = re.compile(r"[^\s\[\]()]+(?:\s*[\[(][^\[\]()]*[\])])?|[\[(][^\[\]()]*[\])]")
 
 
 def read_data_lines(
@@ -41,3 +74,164 @@ def read_data_lines(
     ]
     delimiter = next((d for d in (",", ";", "\t") if any(d in line for _, line in lines)), None)
     return lines, delimiter
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class DelimitedText:
+    """The cells of a delimited text table, not yet converted to numbers.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Column names: from the header, else ``time, column 2, ...``.
+    units : tuple of (str or None)
+        Unit written in each header cell (None: none written, i.e. SI).
+    header : bool
+        Whether the file has a header line.
+    first_line : int
+        Line number of the header (or of the first data row).
+    rows : list of (int, list of str)
+        Line number and stripped cells of each data row.
+    """
+
+    names: tuple[str, ...]
+    units: tuple[str | None, ...]
+    header: bool
+    first_line: int
+    rows: list[tuple[int, list[str]]]
+
+    @property
+    def ncol(self) -> int:
+        """Number of columns (from the first line)."""
+        return len(self.names)
+
+
+def read_delimited(
+    path: str | os.PathLike[str],
+    fail: Callable[[str], Exception],
+    *,
+    what: str,
+    example: str,
+    not_found: str | None = "not found",
+    not_text: str = "is not a text (UTF-8) file",
+) -> DelimitedText:
+    """Read a delimited text table of at least two columns (time first).
+
+    Parameters
+    ----------
+    path : path-like
+        The text file.
+    fail : callable
+        ``fail(detail)`` builds the exception to raise (it adds the file name
+        and the scenario key).
+    what : str
+        What the table is, for messages (``"a trace"``, ``"a record"``).
+    example : str
+        An example header for the message about a missing column.
+    not_found, not_text : str
+        Details for a missing file (None: reported as a read error) and for a
+        file that is not UTF-8 text.
+
+    Returns
+    -------
+    DelimitedText
+
+    Raises
+    ------
+    Exception
+        ``fail(...)``: unreadable or empty file, or one column only (this is
+        checked before any unit, so the message is about the column).
+    """
+    lines, delimiter = read_data_lines(path, fail, not_found=not_found, not_text=not_text)
+    if not lines:
+        raise fail("holds no data")
+
+    def cells(line: str, header: bool = False) -> list[str]:
+        if delimiter is None:  # blanks separate cells; a header keeps "name (unit)" together
+            return _BLANK_HEADER.findall(line) if header else line.split()
+        return [c.strip() for c in next(csv.reader(io.StringIO(line), delimiter=delimiter))]
+
+    n0, first_line = lines[0]
+    first = cells(first_line, header=True)
+    if any(_is_number(c) for c in first):
+        first = cells(first_line)
+    if len(first) < 2:
+        raise fail(
+            f"line {n0}: only one column ({first[0] if first else ''!r}); {what} needs two: time and "
+            f"a value column (e.g. a header `{example}`)"
+        )
+    header = not any(_is_number(c) for c in first)
+    if header:
+        names, units = [], []
+        for cell in first:
+            m = HEADER_CELL.match(cell)
+            name = (m.group("name") if m else cell).strip() or cell.strip()
+            unit = m.group("unit") if m else None
+            names.append(name)
+            units.append(unit.strip() if unit is not None else None)
+        rows = lines[1:]
+    else:
+        names = ["time"] + [f"column {j}" for j in range(2, len(first) + 1)]
+        units = [None] * len(first)
+        rows = lines
+    return DelimitedText(
+        names=tuple(names), units=tuple(units), header=header, first_line=n0,
+        rows=[(n, cells(line)) for n, line in rows],
+    )
+
+
+def numeric_columns(
+    table: DelimitedText,
+    columns: Sequence[int],
+    scales: Sequence[float],
+    fail: Callable[[str], Exception],
+) -> tuple[list[np.ndarray], list[int]]:
+    """Numbers of some columns in SI; the first of ``columns`` is time.
+
+    Each cell is checked (a number, finite) and multiplied by its column's
+    factor in decimal arithmetic; times must increase strictly.
+
+    Returns
+    -------
+    arrays : list of ndarray
+        One per entry of ``columns``, in SI.
+    lines : list of int
+        Line number of each row.
+    """
+    ncol = table.ncol
+    names = table.names
+    unit = table.units[columns[0]] or "s"
+    out: list[list[float]] = [[] for _ in columns]
+    line_numbers: list[int] = []
+    for n, row in table.rows:
+        if len(row) != ncol:
+            raise fail(
+                f"line {n}: {len(row)} column{'s' if len(row) != 1 else ''}, expected {ncol} ({', '.join(names)})"
+            )
+        for k, (j, scale) in enumerate(zip(columns, scales)):
+            cell = row[j]
+            try:
+                x = float(cell)
+            except ValueError:
+                raise fail(f"line {n}, column {j + 1} ({names[j]}): cannot read {cell!r} as a number") from None
+            if math.isnan(x):
+                raise fail(f"line {n}, column {j + 1} ({names[j]}): NaN value")
+            if math.isinf(x):
+                raise fail(f"line {n}, column {j + 1} ({names[j]}): infinite value")
+            value = x if scale == 1.0 else scale_decimal(cell, scale)
+            if k == 0 and out[0] and not value > out[0][-1]:
+                raise fail(
+                    f"line {n}, column {j + 1} ({names[j]}): time {x:g} {unit} does not come after the "
+                    f"previous {out[0][-1] / scale:g} {unit} (times must increase strictly)"
+                )
+            out[k].append(value)
+        line_numbers.append(n)
+    return [np.asarray(v, dtype=float) for v in out], line_numbers

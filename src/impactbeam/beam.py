@@ -142,7 +142,11 @@ class Contactor:
     position : float, [m]
         Distance ``a`` from the left end, in [0, L].
     stiffness : float, [N/m]
-        Contact stiffness ``k`` (positive, finite).
+        Contact stiffness ``k`` (positive); ``inf`` (or ``"inf"``) is a rigid
+        stop. A rigid contactor pins its point in the contact state, so its
+        contact-state modes are defined (:func:`impactbeam.mode_set`), but a
+        transient simulation needs a finite stiffness (see
+        :func:`impactbeam.simulate_system`).
     gap : float, [m]
         Clearance ``c`` >= 0 between the beam at rest and the contactor surface.
     side : {"below", "above"}
@@ -156,9 +160,17 @@ class Contactor:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", nonnegative_finite("contactor.position", self.position))
-        object.__setattr__(self, "stiffness", positive_finite("contactor.stiffness", self.stiffness))
+        k = stiffness("contactor.stiffness", self.stiffness)
+        if k == 0.0:
+            raise ParameterError("contactor.stiffness: must be positive (inf = rigid), got 0.0")
+        object.__setattr__(self, "stiffness", k)
         object.__setattr__(self, "gap", nonnegative_finite("contactor.gap", self.gap))
         choice("contactor.side", self.side, ("below", "above"))
+
+    @property
+    def rigid(self) -> bool:
+        """True for an infinitely stiff contactor (``stiffness = inf``)."""
+        return math.isinf(self.stiffness)
 
     @property
     def direction(self) -> float:

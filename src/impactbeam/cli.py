@@ -14,6 +14,7 @@ commands, so ``impactbeam --help`` stays fast.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import json
 import math
@@ -27,9 +28,10 @@ from typing import Any, TypeVar
 
 import click
 
+from ._warnings import WarningLog
 from .exceptions import ImpactBeamError, ParameterError
 
-__all__ = ["main", "to_jsonable"]
+__all__ = ["main", "to_jsonable", "handle_errors", "take_warnings", "warning_lines"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -46,20 +48,51 @@ def _fail(message: str, status: int) -> None:
     sys.exit(status)
 
 
+_WARNING_LOG: contextvars.ContextVar[WarningLog | None] = contextvars.ContextVar("warning_log", default=None)
+
+
+def take_warnings() -> list[str]:
+    """The ImpactBeamWarnings raised so far in the running command (each once).
+
+    A command that reports them itself (in its summary as ``warning: ...``
+    lines and in ``--json`` as ``"warnings"``) calls this; otherwise
+    :func:`handle_errors` prints them on stderr when the command ends.
+    """
+    log = _WARNING_LOG.get()
+    return [] if log is None else log.take()
+
+
+def warning_lines(messages: list[str]) -> list[str]:
+    """``warning: <message>`` lines for a terminal summary."""
+    return [f"warning: {m}" for m in messages]
+
+
 def handle_errors(fn: F) -> F:
     """Decorator for commands: bad input -> exit 2, failed computation -> exit 1.
 
-    Other modules that register subcommands should use it too.
+    It also records the :class:`~impactbeam.exceptions.ImpactBeamWarning` s
+    raised during the command (see :func:`take_warnings`); those the command
+    did not report are printed on stderr as ``warning: ...`` when it succeeds
+    (an error exit prints only its one ``error:`` line). Other modules that
+    register subcommands should use it too.
     """
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return fn(*args, **kwargs)
-        except ParameterError as exc:
-            _fail(str(exc), 2)
-        except ImpactBeamError as exc:  # SimulationError, ModeSolveError, ...
-            _fail(str(exc), 1)
+        with WarningLog() as log:
+            token = _WARNING_LOG.set(log)
+            try:
+                out = fn(*args, **kwargs)
+            except ParameterError as exc:
+                _fail(str(exc), 2)
+            except ImpactBeamError as exc:  # SimulationError, ModeSolveError, ...
+                _fail(str(exc), 1)
+            finally:
+                _WARNING_LOG.reset(token)
+        if not log.consumed:
+            for line in warning_lines(log.messages):
+                click.echo(line, err=True)
+        return out
 
     return wrapper  # type: ignore[return-value]
 
@@ -90,11 +123,21 @@ def _dumps(obj: Any) -> str:
     return json.dumps(to_jsonable(obj), allow_nan=False)
 
 
+def _number_or_text(value: Any) -> Any:
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return value
+    return value
+
+
 def _load(path: str, overrides: Mapping[str, Any] | None = None) -> Any:
     from .scenario import load_scenario
 
     scenario = load_scenario(path)
-    overrides = {k: v for k, v in (overrides or {}).items() if v is not None}
+    # a command-line number is documented as SI: pass it as a number (a string would be a unit-less string)
+    overrides = {k: _number_or_text(v) for k, v in (overrides or {}).items() if v is not None}
     if overrides:
         scenario = scenario.with_values(overrides)
     return scenario
@@ -105,6 +148,12 @@ def _check_output(option: str, path: str | None, suffixes: tuple[str, ...]) -> N
     if path is None:
         return
     p = Path(path)
+    if not path.strip():
+        raise ParameterError(f"{option}: the file name is empty (use {', '.join(suffixes)})")
+    if p.is_dir() or path.endswith(("/", "\\")):
+        raise ParameterError(
+            f'{option}: "{path}" is a directory; give a file name in it, e.g. "{p / ("result" + suffixes[0])}"'
+        )
     if p.suffix.lower() not in suffixes:
         raise ParameterError(
             f'{option}: unsupported file type "{p.suffix or p.name}" (use {", ".join(suffixes)})'
@@ -276,8 +325,7 @@ def simulate(
         result = run(sc, progress=report)
     metrics = result.metrics()
     metrics["modes"] = result.n_modes
-    metrics["convergence"] = result.convergence
-    metrics["warnings"] = list(result.warnings)
+    metrics["convergence"] = result.convergence  # computed now, so its warning is caught below
     if out is not None:
         try:
             write_result(result, out)
@@ -292,10 +340,11 @@ def simulate(
             _fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:
             _fail(f'--plot: cannot write "{plot}": {exc}', 1)
+    caught = take_warnings()
     if as_json:
-        click.echo(_dumps(metrics))
+        click.echo(_dumps({**metrics, "warnings": caught}))
     else:
-        click.echo(_summary(sc, metrics))
+        click.echo("\n".join([_summary(sc, metrics), *warning_lines(caught)]))
     for label, path in (("result", out), ("figure", plot)):
         if path is not None:
             click.echo(f"wrote {label} to {path}", err=True)
@@ -390,8 +439,6 @@ def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
         key = max(conv, key=lambda k: conv[k])
         lines.append(f"  modes: {metrics.get('modes')}; largest relative change against fewer modes: "
                      f"{conv[key]:.2g} ({key})")
-    for text in metrics.get("warnings") or []:
-        lines.append(f"warning: {text}")
     return "\n".join(lines)
 
 

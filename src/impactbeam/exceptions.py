@@ -6,9 +6,6 @@ exception that fits its meaning, so ``except ValueError`` keeps working.
 
 from __future__ import annotations
 
-import os
-import sys
-import warnings
 
 __all__ = [
     "ImpactBeamError",
@@ -18,7 +15,6 @@ __all__ = [
     "SimulationError",
     "ResourceError",
     "ImpactBeamWarning",
-    "warn",
 ]
 
 
@@ -61,20 +57,12 @@ class ResourceError(ParameterError):
 
 
 class ImpactBeamWarning(UserWarning):
-    """A result the solver is not sure of (e.g. a lossy projection, unconverged modes)."""
+    """A result or an input that needs the user's attention, though not an error.
 
-
-def _stacklevel() -> int:
-    """Stack level of the first frame outside the impactbeam package (xarray's approach)."""
-    pkg = os.path.dirname(os.path.abspath(__file__))
-    level = 1
-    frame = sys._getframe(1)
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(pkg):
-        level += 1
-        frame = frame.f_back
-    return level
-
-
-def warn(message: str, category: type[Warning] = ImpactBeamWarning) -> None:
-    """Issue ``message`` as a warning attributed to the user's code, not to impactbeam."""
-    warnings.warn(message, category, stacklevel=_stacklevel())
+    Emitted through :func:`impactbeam._warnings.emit_user_level_warning`, so
+    the warning points at the user's line, not at impactbeam's internals. The
+    command line collects them and prints each as ``warning: ...`` in its
+    summary and under ``"warnings"`` in ``--json`` output. Silence them with
+    ``warnings.filterwarnings("ignore", category=impactbeam.ImpactBeamWarning)``
+    or turn them into errors with ``"error"``.
+    """

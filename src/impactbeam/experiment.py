@@ -28,9 +28,7 @@ below ``-gap``.
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import io
 import math
 import re
 from collections.abc import Sequence
@@ -40,7 +38,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from ._textdata import read_data_lines
+from ._textdata import numeric_columns, read_delimited
 from .exceptions import ParameterError, ScenarioError, SimulationError
 
 if TYPE_CHECKING:
@@ -209,16 +207,7 @@ class Record:
         return line
 
 
-_HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\[\]()]*)[\])])?\s*$")
 _ACCEL_NAME = re.compile(r"acc|^a$|^ug|^a_?base|^base_?a", re.IGNORECASE)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _value_scale(unit: str, label: str, where: str) -> tuple[float, Quantity]:
@@ -331,38 +320,11 @@ def _read_text(
     def fail(detail: str) -> ScenarioError:
         return ScenarioError(f"{label}: {detail}", key="record")
 
-    lines, delimiter = read_data_lines(
-        p, fail, not_found=None, not_text="is not a text (UTF-8) file; use .csv or .nc"
+    table = read_delimited(
+        p, fail, what="a record", example="time [s],deflection [mm]",
+        not_found=None, not_text="is not a text (UTF-8) file; use .csv or .nc",
     )
-    if not lines:
-        raise fail("holds no data")
-
-    def cells(line: str) -> list[str]:
-        if delimiter is None:
-            return line.split()
-        return [c.strip() for c in next(csv.reader(io.StringIO(line), delimiter=delimiter))]
-
-    n0, first_line = lines[0]
-    first = cells(first_line)
-    header: list[tuple[str, str | None]] | None = None
-    if not any(_is_number(c) for c in first):
-        header = []
-        for cell in first:
-            m = _HEADER_CELL.match(cell)
-            name = (m.group("name") if m else cell).strip() or cell.strip()
-            unit = m.group("unit") if m else None
-            header.append((name, unit.strip() if unit is not None else None))
-        rows = lines[1:]
-        ncol = len(first)
-    else:
-        rows = lines
-        ncol = len(first)
-    if ncol < 2:
-        raise fail(
-            f"line {n0}: only one column; a record needs two: time and one channel "
-            "(e.g. a header `time [s],deflection [mm]`)"
-        )
-    names = [h[0] for h in header] if header else ["time"] + [f"column {j}" for j in range(2, ncol + 1)]
+    n0, ncol, names = table.first_line, table.ncol, list(table.names)
     if channel is None:
         if ncol > 2:
             raise fail(
@@ -374,45 +336,17 @@ def _read_text(
         if channel not in names[1:]:
             raise fail(f"no column {channel!r}; the columns are {', '.join(names)}")
         col = names.index(channel)
-    name = names[col] if header else ("deflection" if quantity != "acceleration" else "acceleration")
-    t_file_unit = header[0][1] if header else None
-    v_file_unit = header[col][1] if header else None
-    t_unit = _merge_unit(time_unit, t_file_unit, "the time unit option", label)
-    v_unit = _merge_unit(value_unit, v_file_unit, "the value unit option", label)
-    t_scale = _time_scale(t_unit, label, f"line {n0}, column 1") if t_unit else 1.0
-    v_scale, q = _value_quantity(v_unit, name, quantity, label, f"line {n0}, column {col + 1}")
-
-    t_list: list[float] = []
-    v_list: list[float] = []
-    where: list[str] = []
-    for n, line in rows:
-        row = cells(line)
-        if len(row) != ncol:
-            raise fail(f"line {n}: {len(row)} column{'s' if len(row) != 1 else ''}, expected {ncol} ({', '.join(names)})")
-        parsed = []
-        for j in (0, col):
-            cell = row[j]
-            try:
-                x = float(cell)
-            except ValueError:
-                raise fail(f"line {n}, column {j + 1} ({names[j]}): cannot read {cell!r} as a number") from None
-            if math.isnan(x):
-                raise fail(f"line {n}, column {j + 1} ({names[j]}): NaN value")
-            if math.isinf(x):
-                raise fail(f"line {n}, column {j + 1} ({names[j]}): infinite value")
-            parsed.append(x)
-        tt = parsed[0] * t_scale
-        if t_list and not tt > t_list[-1]:
-            raise fail(
-                f"line {n}, column 1 ({names[0]}): time {parsed[0]:g} does not come after the previous "
-                f"{t_list[-1] / t_scale:g} (times must increase strictly)"
-            )
-        t_list.append(tt)
-        v_list.append(parsed[1] * v_scale)
-        where.append(f"line {n}")
-    if len(t_list) < MIN_SAMPLES:
-        raise fail(f"has {len(t_list)} data row{'s' if len(t_list) != 1 else ''}; a record needs at least {MIN_SAMPLES}")
-    return np.asarray(t_list), np.asarray(v_list), name, q, where
+    name = names[col] if table.header else ("deflection" if quantity != "acceleration" else "acceleration")
+    t_unit = _merge_unit(time_unit, table.units[0], "the time unit option", label)
+    v_unit = _merge_unit(value_unit, table.units[col], "the value unit option", label)
+    t_scale = _time_scale(t_unit, label, f'line {n0}, column 1 ({names[0]!r}), unit "{t_unit}"') if t_unit else 1.0
+    v_scale, q = _value_quantity(
+        v_unit, name, quantity, label, f'line {n0}, column {col + 1} ({names[col]!r}), unit "{v_unit}"'
+    )
+    (t, v), line_numbers = numeric_columns(table, (0, col), (t_scale, v_scale), fail)
+    if t.size < MIN_SAMPLES:
+        raise fail(f"has {t.size} data row{'s' if t.size != 1 else ''}; a record needs at least {MIN_SAMPLES}")
+    return t, v, name, q, [f"line {n}" for n in line_numbers]
 
 
 def _value_quantity(
@@ -1372,8 +1306,8 @@ class Comparison:
         :data:`FEATURES`; the difference is ``(sim - meas) / |meas|`` in percent.
     rms_difference : float, [m]
         RMS of ``w_sim - w_meas`` at the measured times.
-    nrmse : float
-        ``rms_difference / rms(w_meas)``.
+    nrmse : float or None
+        ``rms_difference / rms(w_meas)``; None when the measured rms is 0.
     """
 
     scenario: Scenario
@@ -1384,7 +1318,7 @@ class Comparison:
     sign: float
     features: dict[str, dict[str, float | None]]
     rms_difference: float
-    nrmse: float
+    nrmse: float | None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-Python summary (for JSON)."""
@@ -1407,7 +1341,8 @@ class Comparison:
             d = f["difference_percent"]
             rows.append((f"{label} [{unit}]", fmt(f["simulated"]), fmt(f["measured"]),
                          "n/a" if d is None else f"{d:+.2f} %"))
-        rows.append(("rms difference [mm]", f"{self.rms_difference * 1e3:.4f}", "", f"{self.nrmse * 100:.1f} % of rms"))
+        rel = "n/a (measured rms is 0)" if self.nrmse is None else f"{self.nrmse * 100:.1f} % of rms"
+        rows.append(("rms difference [mm]", f"{self.rms_difference * 1e3:.4f}", "", rel))
         widths = [max(len(r[j]) for r in rows) for j in range(4)]
         lines = [
             f"Comparison at x = {self.point * 1e3:.4g} mm (u = {'-w' if self.sign < 0 else 'w'}, "
@@ -1551,7 +1486,14 @@ def compare(
     diff = w_sim - meas.values
     rms = float(np.sqrt(np.mean(diff**2)))
     rms_m = float(np.sqrt(np.mean(meas.values**2)))
+    if float(np.ptp(meas.values)) <= 1e-12 * max(float(np.max(np.abs(meas.values))), 1e-300):
+        from ._warnings import emit_user_level_warning
+
+        emit_user_level_warning(
+            f"{meas.label}: the measured deflection is constant ({float(meas.values[0]):.6g} m) over the "
+            "compared window; the measured features are undefined and the comparison says little"
+        )
     return Comparison(
         scenario=sc, result=result, measured=meas, simulated=sim_rec, point=x, sign=sign,
-        features=feats, rms_difference=rms, nrmse=rms / rms_m if rms_m > 0 else math.inf,
+        features=feats, rms_difference=rms, nrmse=rms / rms_m if rms_m > 0 else None,
     )

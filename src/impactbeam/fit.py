@@ -174,7 +174,7 @@ class FitResult:
     initial_rms_residual : float, [m]
         The same at the starting values.
     nrmse : float
-        ``rms_residual / rms(w_meas)``.
+        ``rms_residual / rms(w_meas)``; NaN when the record's rms is 0.
     nfev : int
         Simulations run.
     success : bool
@@ -256,7 +256,8 @@ class FitResult:
                  f"to {self.residual.size} samples at x = {self.point * 1e3:.4g} mm"]
         lines += ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
         lines.append(
-            f"  rms residual {self.rms_residual * 1e3:.4g} mm ({100 * self.nrmse:.2f} % of the rms record; "
+            f"  rms residual {self.rms_residual * 1e3:.4g} mm ("
+            f"{f'{100 * self.nrmse:.2f} % of the rms record' if math.isfinite(self.nrmse) else 'record rms is 0'}; "
             f"{self.initial_rms_residual * 1e3:.4g} mm at the start), {self.nfev} simulations"
         )
         if len(self.paths) > 1 and np.all(np.isfinite(self.correlation)):
@@ -530,7 +531,7 @@ def fit(
         bounds=used_bounds,
         rms_residual=rms,
         initial_rms_residual=float(np.sqrt(np.mean(r0**2))),
-        nrmse=rms / rms_m if rms_m > 0 else math.inf,
+        nrmse=rms / rms_m if rms_m > 0 else math.nan,
         nfev=counter["n"],
         success=bool(out.success),
         message=str(out.message),

@@ -191,7 +191,7 @@ class SimulationResult:
         None when it cannot be computed (one mode).
         """
         if "_convergence" not in self.__dict__:
-            from .exceptions import warn
+            from ._warnings import emit_user_level_warning as warn
             from .solver.convergence import coarser_count, relative_changes
 
             if self.rerun is None or self.n_modes <= 1:

@@ -23,9 +23,7 @@ The file format is described in ``examples/README.md``.
 from __future__ import annotations
 
 import copy
-import csv
 import difflib
-import io
 import math
 import os
 import re
@@ -39,13 +37,14 @@ from typing import Any
 import numpy as np
 
 from ._atomic import write_text
-from ._textdata import read_data_lines
+from ._checks import check_magnitudes, warn_numeric_strings, warn_unusual
+from ._textdata import numeric_columns, read_delimited
 from ._validation import choice, nonnegative_finite, positive_finite
 from .beam import SUPPORT_PRESETS, Beam, Contactor, Support
 from .exceptions import ParameterError, ScenarioError
 from .loading import Excitation, InitialCondition
 from .solver.options import Damping, SolverOptions
-from .units import describe_dimension, scale_decimal, to_si, unit_scale
+from .units import DIMENSIONS, describe_dimension, to_si, unit_scale
 
 __all__ = [
     "Scenario",
@@ -588,13 +587,22 @@ def _parse_beam(raw: Mapping[str, Any]) -> Beam:
     )
 
 
+def _contact_stiffness(table: Mapping[str, Any], prefix: str) -> float:
+    """A contactor's stiffness: positive, finite or ``"inf"`` (a rigid stop)."""
+    key = _join(prefix, "stiffness")
+    k = to_si(table["stiffness"], "stiffness", key)
+    if not k > 0.0:
+        raise ScenarioError(f'{key}: must be positive ("inf" = rigid), got {k!r}', key=key)
+    return k
+
+
 def _parse_contactors(raw: Mapping[str, Any], beam: Beam) -> tuple[Contactor, ...]:
     out = []
     for i, c in enumerate(raw.get("contactors", [])):
         prefix = f"contactors.{i}"
         position = _position(c, prefix, beam.length, required=True)
         _required(c, prefix, "stiffness")
-        stiffness = _positive(c, prefix, "stiffness", "stiffness")
+        stiffness = _contact_stiffness(c, prefix)
         gap = _nonnegative(f"{prefix}.gap", c.get("gap", 0.0), "length")
         side = _choice(f"{prefix}.side", c.get("side", "below"), _SIDES)
         with _relabel(prefix, (("contactor.", f"{prefix}."),)):
@@ -856,6 +864,8 @@ def parse_scenario(
         raise ScenarioError(f"a scenario must be a mapping of tables, got {type(data).__name__}")
     raw = _normalise(data)
     _check_structure(raw, _SCHEMA, "", raw)
+    check_magnitudes(raw)
+    warn_numeric_strings(raw)
     if "name" in raw:
         name = _string("name", raw["name"])
     if "description" in raw:
@@ -869,7 +879,7 @@ def parse_scenario(
     initial = _parse_initial(raw, beam)
     solver = _parse_solver(raw)
     points = _parse_output(raw, beam, contactors)
-    return Scenario(
+    scenario = Scenario(
         beam=beam,
         contactors=contactors,
         damping=damping,
@@ -882,6 +892,8 @@ def parse_scenario(
         base_dir=base,
         name=name,
     )
+    warn_unusual(scenario)
+    return scenario
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
@@ -896,13 +908,15 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
         For a missing or unreadable file, a TOML syntax error (with the
         parser's line and column) or invalid content.
     """
+    if not str(path).strip():
+        raise ScenarioError("cannot read scenario: the path is empty; give a scenario file (.toml)")
     p = Path(path)
     try:
         text = p.read_bytes().decode("utf-8")
     except FileNotFoundError:
         raise ScenarioError(f'cannot read scenario "{path}": file not found') from None
     except IsADirectoryError:
-        raise ScenarioError(f'cannot read scenario "{path}": it is a directory') from None
+        raise ScenarioError(f'cannot read scenario "{path}": it is a directory, not a scenario file (.toml)') from None
     except UnicodeDecodeError:
         raise ScenarioError(f'cannot read scenario "{path}": not UTF-8 text') from None
     except OSError as exc:
@@ -918,17 +932,6 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
 # --------------------------------------------------------------------------- tables
 
 
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-_HEADER_CELL = re.compile(r"^\s*(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?\s*$")
-
-
 def read_table(
     path: str | os.PathLike[str],
     *,
@@ -937,6 +940,10 @@ def read_table(
     label: str | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Read a two-column trace ``time, value`` from a CSV file, in SI units.
+
+    The file is read by the same reader as measured records
+    (:func:`impactbeam.experiment.load_record`), so both honour the same
+    unit headers.
 
     Parameters
     ----------
@@ -961,17 +968,19 @@ def read_table(
 
     Notes
     -----
-    An optional first line names the columns, with units in brackets:
-    ``time [ms],acceleration [g]``. A column without a unit, or a file without
-    a header, is SI.
+    An optional first line names the columns, with units in brackets or
+    parentheses: ``time [ms],acceleration [g]`` or ``time (ms),acceleration
+    (g)`` (``g`` = 9.80665 m/s^2 for an acceleration). A column without a
+    unit, or a file without a header, is SI. Each number is scaled in decimal
+    arithmetic, so ``1.5`` ms gives exactly the float ``0.0015``.
 
     Raises
     ------
     ScenarioError
         With ``key``, the file name and the line number: missing or unreadable
-        file, fewer than two rows, a wrong number of columns, a non-numeric
-        cell, NaN or infinity, non-increasing times, an unknown unit or one of
-        the wrong dimension.
+        file, one column only, fewer than two rows, a wrong number of columns,
+        a non-numeric cell, NaN or infinity, non-increasing times, an unknown
+        unit or one of the wrong dimension (naming the column and the unit).
     """
     name = str(path) if label is None else label
 
@@ -979,57 +988,26 @@ def read_table(
         return ScenarioError(f'{key}: "{name}" {detail}', key=key)
 
     where = "" if str(path) == name else f" (looked for {path})"
-    lines, delimiter = read_data_lines(path, fail, not_found=f"not found{where}")
-
-    def cells(line: str) -> list[str]:
-        if delimiter is None:
-            return line.split()
-        return next(csv.reader(io.StringIO(line), delimiter=delimiter))
-
+    table = read_delimited(
+        path, fail, what="a trace", example=f"time [s],value [{DIMENSIONS[value_dimension].si_unit}]",
+        not_found=f"not found{where}",
+    )
+    if table.ncol != 2:
+        raise fail(
+            f"line {table.first_line}: {table.ncol} columns ({', '.join(table.names)}), expected 2 (time, value)"
+        )
     scales = [1.0, 1.0]
-    rows = lines
-    if lines:
-        n, line = lines[0]
-        first = cells(line)
-        if not any(_is_number(c) for c in first):  # a header names every column
-            rows = lines[1:]
-            if len(first) != 2:
-                raise fail(f"line {n}: the header has {len(first)} columns, expected 2 (time, value)")
-            for j, (cell, dimension) in enumerate(zip(first, ("time", value_dimension))):
-                m = _HEADER_CELL.match(cell)
-                unit = m.group("unit") if m else None
-                if unit is not None:
-                    try:
-                        scales[j] = unit_scale(unit, dimension, key)
-                    except ScenarioError as exc:
-                        detail = str(exc).partition(": ")[2]
-                        raise fail(f"line {n}, column {j + 1} ({cell.strip()!r}): {detail}") from None
-
-    times: list[float] = []
-    values: list[float] = []
-    for n, line in rows:
-        row = cells(line)
-        if len(row) != 2:
-            raise fail(f"line {n}: {len(row)} columns, expected 2 (time, value)")
-        parsed = []
-        for j, cell in enumerate(row):
+    for j, dimension in enumerate(("time", value_dimension)):
+        unit = table.units[j]
+        if unit is not None:
             try:
-                v = float(cell.strip())
-            except ValueError:
-                raise fail(f"line {n}, column {j + 1}: cannot read {cell.strip()!r} as a number") from None
-            if math.isnan(v):
-                raise fail(f"line {n}, column {j + 1}: NaN value")
-            if math.isinf(v):
-                raise fail(f"line {n}, column {j + 1}: infinite value")
-            parsed.append(v if scales[j] == 1.0 else scale_decimal(cell, scales[j]))
-        t = parsed[0]
-        if times and not t > times[-1]:
-            raise fail(
-                f"line {n}: time {t:g} s does not come after the previous {times[-1]:g} s "
-                "(times must increase strictly)"
-            )
-        times.append(t)
-        values.append(parsed[1])
-    if len(times) < 2:
-        raise fail(f"has {len(times)} data row{'' if len(times) == 1 else 's'}; a trace needs at least 2")
-    return np.asarray(times, dtype=float), np.asarray(values, dtype=float)
+                scales[j] = unit_scale(unit, dimension, key)
+            except ScenarioError as exc:
+                detail = str(exc).partition(": ")[2]
+                raise fail(
+                    f'line {table.first_line}, column {j + 1} ({table.names[j]!r}), unit "{unit}": {detail}'
+                ) from None
+    (times, values), _ = numeric_columns(table, (0, 1), scales, fail)
+    if times.size < 2:
+        raise fail(f"has {times.size} data row{'' if times.size == 1 else 's'}; a trace needs at least 2")
+    return times, values

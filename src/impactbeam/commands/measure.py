@@ -15,10 +15,17 @@ from typing import Any
 
 import click
 
-from ..cli import PLOT_SUFFIXES, _check_output, _dumps, handle_errors
+from ..cli import (
+    PLOT_SUFFIXES,
+    _check_output,
+    _dumps,
+    handle_errors,
+    take_warnings,
+    warning_lines,
+)
 from ..exceptions import ParameterError
 
-__all__ = ["COMMANDS", "identify", "compare", "fit"]
+__all__ = ["COMMANDS", "compare", "fit", "identify"]
 
 _RECORD_OPTIONS = [
     click.option("--time-unit", default=None, metavar="UNIT",
@@ -115,23 +122,19 @@ def identify(
     RECORD is a CSV (header `time,deflection`, SI, or with units such as
     `time [s],deflection [mm]`) or netCDF file of a release test (paper
     Case 0/13). Frequencies come from the Hann-windowed, zero-padded
-    spectrum with interpolated peaks; damping ratios from the logarithmic
-    decrement of each band-passed mode, averaged over the cycles, with the
-    spread over the cycles. With --scenario, the Young's modulus that gives
-    the model's first free-state frequency the measured (undamped) value;
-    with --contact-frequency or --contact-record as well, the contact
-    stiffness whose contact-state fundamental matches (paper section 4.2),
-    computed with the identified modulus.
+    spectrum with interpolated peaks. Damping ratios by two independent
+    estimators that work on ~10 cycles: a damped-sine least-squares fit of
+    all modes (reported, with its standard error) and the matrix-pencil
+    method; their difference is the spread. The paper's logarithmic
+    decrement is shown too when the record is long enough. With --scenario,
+    the Young's modulus that gives the model's first free-state frequency
+    the measured (undamped) value; with --contact-frequency or
+    --contact-record as well, the contact stiffness whose contact-state
+    fundamental matches (paper section 4.2), computed with the identified
+    modulus. A record with no significant oscillation exits with status 2.
     """
-    from ..experiment import (
-        contact_frequency_from_record,
-        contact_state_frequency,
-        contact_stiffness_from_frequency,
-        damping_log_decrement,
-        identify_frequencies,
-        load_record,
-        modulus_from_frequency,
-    )
+    from ..experiment import load_record
+    from ..identification import identify as run_identify
 
     if count < 1:
         raise ParameterError(f"--count: must be a positive integer, got {count}")
@@ -152,91 +155,59 @@ def identify(
     _note(rec)
     if rec.quantity != "deflection":
         raise ParameterError(f"{rec.label}: identify needs a deflection record, got an acceleration")
-    fe = identify_frequencies(rec, count)
-    freqs = [float(f) for f in fe.frequencies_hz]
-    damping: list[Any] = []
-    for f in freqs:
-        try:
-            damping.append(damping_log_decrement(rec, f, neighbours=[g for g in freqs if g != f]))
-        except ParameterError as exc:
-            damping.append(None)
-            click.echo(f"note: no damping ratio at {f:.4g} Hz: {exc}", err=True)
-    result: dict[str, Any] = {
-        "record": record,
-        "n_samples": int(rec.time.size),
-        "sample_rate_hz": rec.sample_rate,
-        "resolution_hz": fe.resolution_hz,
-        "frequencies_hz": freqs,
-        "damping_ratios": [None if d is None else d.damping_ratio for d in damping],
-        "damping_spread": [None if d is None else d.spread for d in damping],
-        "damping_cycles": [None if d is None else d.n_cycles for d in damping],
-        "notes": list(rec.notes),
-    }
-    updates: dict[str, Any] = {}
+    crec = None
+    if contact_record is not None:
+        crec = load_record(contact_record, time_unit=time_unit, value_unit=value_unit, channel=channel)
+        _note(crec)
+    ident = run_identify(rec, count, scenario=sc, contact_frequency=f_contact, contact_record=crec, contactor=contactor)
+    for d in ident.damping:
+        if d.log_decrement is None:
+            click.echo(f"note: no logarithmic decrement at {d.frequency_hz:.4g} Hz: {d.log_decrement_note}", err=True)
+    result = ident.to_dict()
+    result["record"] = record
     if sc is not None:
-        xi1 = damping[0].damping_ratio if damping and damping[0] is not None else 0.0
-        f1n = freqs[0] / math.sqrt(1.0 - xi1**2)  # spectral peak is the damped frequency
-        from ..modes import mode_set
-
-        ms0 = mode_set(sc.beam, (), sc.solver.modes)
-        e_new = modulus_from_frequency(sc, f1n)
-        updates["beam.youngs_modulus"] = e_new
-        result.update({
-            "scenario": scenario,
-            "natural_frequency_hz": f1n,
-            "model_frequencies_hz": [float(f) for f in ms0.frequencies_hz[ms0.n_rigid : ms0.n_rigid + count]],
-            "scenario_youngs_modulus": sc.beam.youngs_modulus,
-            "youngs_modulus": e_new,
-            "youngs_modulus_change_percent": 100.0 * (e_new / sc.beam.youngs_modulus - 1.0),
-        })
-        sc_e = sc.with_values({"beam.youngs_modulus": e_new})
-        ms1 = mode_set(sc_e.beam, (), sc.solver.modes)
-        result["tuned_frequencies_hz"] = [float(f) for f in ms1.frequencies_hz[ms1.n_rigid : ms1.n_rigid + count]]
+        result["scenario"] = scenario
         if contact_record is not None:
-            crec = load_record(contact_record, time_unit=time_unit, value_unit=value_unit, channel=channel)
-            _note(crec)
-            cf = contact_frequency_from_record(crec, sc_e, contactor=contactor)
-            f_contact = cf.frequency_hz
-            result.update({
-                "contact_record": contact_record,
-                "contact_intervals": len(cf.intervals),
-                "contact_frequency_half_period_hz": cf.half_period_hz,
-            })
-        if f_contact is not None:
-            k = contact_stiffness_from_frequency(sc_e, f_contact, contactor)
-            updates[f"contactors.{contactor}.stiffness"] = k
-            result.update({
-                "contact_frequency_hz": f_contact,
-                "scenario_contact_stiffness": sc.contactors[contactor].stiffness,
-                "scenario_contact_frequency_hz": contact_state_frequency(sc_e, sc.contactors[contactor].stiffness, contactor),
-                "contact_stiffness": k,
-            })
+            result["contact_record"] = contact_record
         if out is not None:
             from ..scenario import dump_scenario, set_path
 
             data = sc.data
-            for path, value in updates.items():
+            for path, value in ident.updates.items():
                 data = set_path(data, path, value)
             dump_scenario(data, out)
             result["out"] = out
+    result["warnings"] = take_warnings()
     if as_json:
         click.echo(_dumps(result))
     else:
-        click.echo(_identify_text(result))
+        click.echo("\n".join([_identify_text(result), *warning_lines(result["warnings"])]))
     if out is not None:
         click.echo(f"wrote scenario to {out}", err=True)
+
+
+def _pct(x: float | None, digits: int = 3) -> str:
+    return "n/a" if x is None else f"{100 * x:.{digits}f}"
 
 
 def _identify_text(r: dict[str, Any]) -> str:
     lines = [
         f"Identification from {r['record']}: {r['n_samples']} samples at {r['sample_rate_hz']:.6g} Hz "
-        f"(resolution {r['resolution_hz']:.4g} Hz)",
-        "  mode  frequency [Hz]  damping ratio [%]     cycles",
+        f"over {r['duration_s']:.4g} s (resolution {r['resolution_hz']:.4g} Hz)",
+        "  damping ratio [%]: least-squares fit +/- standard error; matrix pencil; spread = |fit - pencil|;",
+        "  logarithmic decrement +/- its spread over cycles (paper 4.1), where the record allows it",
+        "  mode  frequency [Hz]       fit [%]  pencil [%]  spread [%]   log decrement [%] (cycles)",
     ]
     for i, f in enumerate(r["frequencies_hz"]):
-        xi, sp, nc = r["damping_ratios"][i], r["damping_spread"][i], r["damping_cycles"][i]
-        d = "n/a" if xi is None else f"{100 * xi:.3f} +/- {100 * sp:.3f}"
-        lines.append(f"  {i + 1:>4}  {f:>14.4f}  {d:>19}  {nc if nc is not None else '':>9}")
+        fit = "n/a" if r["damping_ratios"][i] is None else (
+            f"{_pct(r['damping_ratios'][i])} +/- {_pct(r['damping_standard_errors'][i])}")
+        ld = r["damping_log_decrement"][i]
+        ldt = "n/a" if ld is None else (
+            f"{_pct(ld)} +/- {_pct(r['damping_cycle_spread'][i])} ({r['damping_cycles'][i]})")
+        lines.append(
+            f"  {i + 1:>4}  {f:>14.4f}  {fit:>14}  {_pct(r['damping_matrix_pencil'][i]):>10}  "
+            f"{_pct(r['damping_spread'][i]):>10}   {ldt}"
+        )
     if "youngs_modulus" in r:
         lines.append(
             f"  model ({r['scenario']}): first frequency {r['model_frequencies_hz'][0]:.4f} Hz with "
@@ -304,13 +275,14 @@ def compare(
     cmp = run_compare(sc, meas, excitation=trace, hold=hold, point=x, window=win)  # type: ignore[arg-type]
     if plot is not None:
         cmp.plot(plot)
+    caught = take_warnings()
     if as_json:
         d = cmp.to_dict()
         d.update({"scenario": scenario, "measured": measured, "excitation": excitation,
-                  "hold": hold if excitation else None, "plot": plot})
+                  "hold": hold if excitation else None, "plot": plot, "warnings": caught})
         click.echo(_dumps(d))
     else:
-        click.echo(cmp.table())
+        click.echo("\n".join([cmp.table(), *warning_lines(caught)]))
     if plot is not None:
         click.echo(f"wrote figure to {plot}", err=True)
 
@@ -371,13 +343,14 @@ def fit(
     written: list[Path] = []
     if out is not None:
         written = res.write_scenario(out)
+    caught = take_warnings()
     if as_json:
         d = res.to_dict()
         d.update({"scenario": scenario, "measured": measured, "out": out,
-                  "written": [str(p) for p in written]})
+                  "written": [str(p) for p in written], "warnings": caught})
         click.echo(_dumps(d))
     else:
-        click.echo(res.report())
+        click.echo("\n".join([res.report(), *warning_lines(caught)]))
     for p in written:
         click.echo(f"wrote {p}", err=True)
 

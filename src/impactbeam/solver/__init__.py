@@ -7,13 +7,15 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from ..beam import Beam, Contactor
-from ..exceptions import ParameterError, warn
+from .._warnings import emit_user_level_warning as warn
+from ..exceptions import ParameterError
 from ..loading import Excitation, InitialCondition
 from .convergence import AUTO_COUNTS, relative_changes
 from .engine import integrate
@@ -52,6 +54,14 @@ def simulate_system(
     contactors = tuple(contactors)
     for i, c in enumerate(contactors):
         c.check_on(beam, f"contactors.{i}")
+        if np.isinf(c.stiffness):
+            k_ref = 3.0 * beam.bending_stiffness / beam.length**3
+            raise ParameterError(
+                f'contactors.{i}.stiffness: "inf" (a rigid stop) has contact-state modes (impactbeam modes) '
+                "but cannot be simulated: an impact on a rigid stop needs a restitution law the modal model "
+                f"does not have; give a finite stiffness (the stop's measured contact stiffness; for scale, "
+                f"3 E I / L^3 of this beam is {k_ref:.4g} N/m)"
+            )
     if points is None:
         pts = [c.position for c in contactors] + [beam.length]
         points = list(dict.fromkeys(pts))
@@ -117,6 +127,23 @@ def _check_distinct(contactors: tuple[Contactor, ...]) -> None:
         seen[key] = i
 
 
+def _require_scenario(scenario: object) -> None:
+    """TypeError for anything but a Scenario (a path, a dict), saying what to do."""
+    from ..scenario import Scenario
+
+    if isinstance(scenario, Scenario):
+        return
+    if isinstance(scenario, (str, os.PathLike)):
+        raise TypeError(
+            f"simulate: got the path {str(scenario)!r}; read it first: "
+            "impactbeam.simulate(impactbeam.load_scenario(path))"
+        )
+    raise TypeError(
+        f"simulate: expected a Scenario (from impactbeam.load_scenario or parse_scenario), got "
+        f"{type(scenario).__name__}; for a beam given as objects use impactbeam.simulate_system"
+    )
+
+
 def simulate(
     scenario: Scenario,
     *,
@@ -139,6 +166,13 @@ def simulate(
     Returns
     -------
     SimulationResult
+
+    Raises
+    ------
+    TypeError
+        When ``scenario`` is not a Scenario (e.g. a file path).
+    ParameterError
+        For a rigid contactor (``stiffness = inf``): give a finite stiffness.
 
     Notes
     -----
@@ -167,6 +201,7 @@ def simulate(
     Warnings the solver raises (:class:`~impactbeam.exceptions.ImpactBeamWarning`)
     are also listed in ``result.warnings``.
     """
+    _require_scenario(scenario)
     return simulate_system(
         scenario.beam,
         scenario.contactors,

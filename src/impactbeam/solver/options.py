@@ -71,7 +71,9 @@ class SolverOptions:
     max_events : int
         Chattering guard: the run stops (status 1) after this many events.
     event_tolerance : float, [s]
-        Absolute accuracy of located event times.
+        Absolute accuracy of located event times. Must be smaller than
+        ``time_step``; above 1e-3 ``time_step`` an
+        :class:`~impactbeam.exceptions.ImpactBeamWarning` is emitted.
     projection : {"paper", "contact"}
         How modal coordinates pass from one state to the next at an event.
         ``"paper"`` (default): the L2 projection of displacement and velocity
@@ -122,3 +124,26 @@ class SolverOptions:
         object.__setattr__(
             self, "event_tolerance", positive_finite("solver.event_tolerance", self.event_tolerance)
         )
+        self._check_event_tolerance()
+
+    def _check_event_tolerance(self) -> None:
+        """Refuse an event tolerance of a scan step or more; warn above 1e-3 of it.
+
+        An event located only to within the output (and scan) step says
+        nothing the grid does not; above 1e-3 of the step the event times, and
+        the contact durations and impact times derived from them, carry an
+        error visible at the output resolution.
+        """
+        tol, dt = self.event_tolerance, self.time_step
+        if tol >= dt:
+            raise ParameterError(
+                f"solver.event_tolerance: {tol:g} s is not smaller than solver.time_step ({dt:g} s); "
+                f"event times would be no better than the output grid (default 1e-13 s)"
+            )
+        if tol > 1e-3 * dt:
+            from .._warnings import emit_user_level_warning
+
+            emit_user_level_warning(
+                f"solver.event_tolerance: {tol:g} s is more than 1e-3 of solver.time_step ({dt:g} s); "
+                f"impact times and contact durations are only that accurate (default 1e-13 s)"
+            )
