@@ -20,6 +20,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.faults
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CLI = [sys.executable, "-c", "import sys; from impactbeam.cli import main; sys.argv[0] = 'impactbeam'; main()"]
 
@@ -92,3 +94,51 @@ def test_modes_count_is_capped():
     out = subprocess.run([*CLI, "modes", str(EXAMPLES / "case03.toml"), "--count", "1000"], capture_output=True,
                          text=True, timeout=120)
     assert out.returncode == 2 and "--count: expected 1 to 200 modes" in out.stderr
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_sweep_stops_on_signal_and_keeps_finished_cases(tmp_path, sig, code):
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        f'base = "{(EXAMPLES / "case03.toml").as_posix()}"\n'
+        '[parameters."contactors.0.gap"]\nrange = [0.0, 0.686e-3, 200]\n'
+        '[parameters."excitation.duration"]\nrange = [5e-3, 20e-3, 100]\n'
+    )
+    out = tmp_path / "s.zarr"
+    proc = subprocess.Popen([*CLI, "sweep", str(spec), "--out", str(out), "--workers", "0"], cwd=tmp_path,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    import xarray as xr
+
+    deadline = time.monotonic() + 180.0  # a cold start compiles the kernels first
+    while time.monotonic() < deadline:  # wait until some batches are in the store
+        time.sleep(1.0)
+        if out.exists():
+            try:
+                if (xr.open_zarr(out, consolidated=False)["status"].values == 0).any():
+                    break
+            except (OSError, KeyError, ValueError):
+                pass
+    assert proc.poll() is None, proc.communicate()
+    t0 = time.monotonic()
+    os.killpg(proc.pid, sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == code, err[-2000:]
+    assert time.monotonic() - t0 < 5.0
+    assert "Traceback" not in err and "run the same command again" in err
+    assert not (tmp_path / "s.zarr.lock").exists()
+    status = xr.open_zarr(out, consolidated=False)["status"].values
+    assert 0 < int((status == 0).sum()) < status.size  # finished cases kept, the rest to do
+
+
+def test_stale_temporary_files_of_killed_writers_are_removed(tmp_path):
+    # a writer killed with SIGKILL cannot clean up; the next write to the same target does
+    from impactbeam._atomic import write_text
+
+    target = tmp_path / "out.toml"
+    dead = 2**22 + 4321
+    stale = tmp_path / f".out.toml.{dead}.abc123.tmp"
+    stale.write_text("")
+    write_text(target, "x = 1\n")
+    assert target.read_text() == "x = 1\n"
+    assert not stale.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.toml"]

@@ -71,6 +71,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from ._atomic import pid_alive
 from .exceptions import ImpactBeamError, ParameterError, ScenarioError, SimulationError
 from .metrics import METRIC_UNITS
 from .scenario import EXCITATION_DIMENSIONS, Scenario, load_scenario, parse_scenario
@@ -1194,7 +1195,7 @@ class _StoreLock:
                 fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
             except FileExistsError:
                 holder = self._holder()
-                if holder is not None and holder.get("host") == me["host"] and not _alive(holder.get("pid")):
+                if holder is not None and holder.get("host") == me["host"] and not pid_alive(holder.get("pid")):
                     with contextlib.suppress(FileNotFoundError):
                         os.unlink(self.path)  # stale: its process is gone
                     continue
@@ -1222,16 +1223,6 @@ class _StoreLock:
         if self.path is not None:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(self.path)
-
-
-def _alive(pid: Any) -> bool:
-    try:
-        os.kill(int(pid), 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, TypeError, ValueError, OverflowError):
-        return True
-    return True
 
 
 def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], workers: int | None,
