@@ -29,6 +29,10 @@ __all__ = [
 
 RESULT_SUFFIXES = (".nc", ".csv", ".parquet")
 _CHUNK = 65536  # samples evaluated per call of the compiled sampler
+_REFERENCE = (
+    "W. Xu and E. K. Ervin, Parameters affecting the transient response of an impacting beam, "
+    "Shock and Vibration 20 (2013)"
+)
 
 
 def memory_limit() -> int:
@@ -146,6 +150,7 @@ class SimulationResult:
     options: dict[str, Any] = field(default_factory=dict)
     rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False)
     tolerance: float = 2e-3
+    scenario_text: str | None = field(default=None, repr=False)
 
     # ------------------------------------------------------------------ from the solution
     @property
@@ -356,52 +361,95 @@ class SimulationResult:
 
         return compute_metrics(self, impacts=impacts)
 
+    @property
+    def impacts(self):
+        """The per-impact table as a :class:`pandas.DataFrame` (one row per contact interval).
+
+        Columns: ``contactor``, ``start`` [s], ``end`` [s], ``duration`` [s],
+        ``peak_force`` [N], ``impulse`` [N s]; exact (closed form), see
+        :mod:`impactbeam.metrics`.
+        """
+        import pandas as pd
+
+        cols = ["contactor", "start", "end", "duration", "peak_force", "impulse"]
+        rows = self.metrics()["impacts"]
+        df = pd.DataFrame(rows, columns=cols).astype({"end": float, "duration": float})
+        df.attrs["units"] = {"start": "s", "end": "s", "duration": "s", "peak_force": "N", "impulse": "N s"}
+        return df
+
     def to_xarray(self) -> xr.Dataset:
-        """The result as a labelled :class:`xarray.Dataset` with units in the attributes."""
+        """The result as a CF-style :class:`xarray.Dataset`, with units and its provenance.
+
+        Every variable has ``units`` (UDUNITS) and ``long_name``; the states are
+        CF flags (``flag_values``/``flag_meanings``); the global attributes hold
+        ``Conventions``, ``title``, ``history``, ``source``, ``references`` (the
+        paper), the scenario as TOML text (``scenario``), the metrics as JSON
+        (``metrics``), the solver options, status, message and warnings.
+        """
+        import datetime
+
         import xarray as xr
 
         from . import __version__
 
         n_c = len(self.contactors)
+        kind = np.array([1 if e.kind == "impact" else 0 for e in self.events], dtype=np.int8)
+        flag = {"flag_values": np.array([0, 1], dtype=np.int8)}
         ds = xr.Dataset(
             {
-                "w": (("time", "point"), self.w, {"units": "m", "long_name": "deflection"}),
-                "w_t": (("time", "point"), self.w_t, {"units": "m/s", "long_name": "velocity"}),
+                "w": (("time", "point"), self.w, {"units": "m", "long_name": "deflection w(x, t)"}),
+                "w_t": (("time", "point"), self.w_t, {"units": "m s-1", "long_name": "velocity w_t(x, t)"}),
                 "contact_force": (
-                    ("time", "contactor"), self.contact_force, {"units": "N", "long_name": "contact force"}
+                    ("time", "contactor"), self.contact_force, {"units": "N", "long_name": "contact force on the beam"}
                 ),
-                "engaged": (("time", "contactor"), self.engaged, {"long_name": "contactor engaged"}),
+                "engaged": (("time", "contactor"), self.engaged.astype(np.int8),
+                            {"long_name": "contactor state", **flag, "flag_meanings": "free engaged"}),
                 "w_contactor": (
-                    ("time", "contactor"), self.w_contact, {"units": "m", "long_name": "deflection at contactor"}
+                    ("time", "contactor"), self.w_contact, {"units": "m", "long_name": "deflection at the contactor"}
                 ),
                 "modal_displacement": (
                     ("time", "mode"), self.eta,
-                    {"units": "m kg^0.5", "long_name": "modal displacement (basis of the current state)"},
+                    {"long_name": "modal displacement in the basis of the current state",
+                     "comment": "mass-normalised modal coordinate: unit m kg^(1/2), which UDUNITS cannot express"},
                 ),
                 "modal_velocity": (
-                    ("time", "mode"), self.eta_t, {"units": "m kg^0.5/s", "long_name": "modal velocity"}
+                    ("time", "mode"), self.eta_t,
+                    {"long_name": "modal velocity", "comment": "unit m kg^(1/2) s^-1"},
                 ),
-                "event_time": (("event",), np.array([e.time for e in self.events], dtype=float), {"units": "s"}),
-                "event_kind": (("event",), np.array([e.kind for e in self.events], dtype=str)),
-                "event_contactor": (("event",), np.array([e.contactor for e in self.events], dtype=int)),
+                "event_time": (("event",), np.array([e.time for e in self.events], dtype=float),
+                               {"units": "s", "long_name": "event time"}),
+                "event_kind": (("event",), kind, {"long_name": "event kind", **flag,
+                                                  "flag_meanings": "rebound impact"}),
+                "event_contactor": (("event",), np.array([e.contactor for e in self.events], dtype=np.int32),
+                                    {"long_name": "contactor of the event"}),
             },
             coords={
-                "time": ("time", self.time, {"units": "s", "long_name": "time"}),
+                "time": ("time", self.time, {"units": "s", "long_name": "time", "standard_name": "time"}),
                 "point": ("point", self.points, {"units": "m", "long_name": "position along the beam"}),
-                "contactor": ("contactor", np.arange(n_c)),
+                "contactor": ("contactor", np.arange(n_c, dtype=np.int32), {"long_name": "contactor index"}),
                 "contactor_position": (
-                    "contactor", np.array([c.position for c in self.contactors], dtype=float), {"units": "m"}
+                    "contactor", np.array([c.position for c in self.contactors], dtype=float),
+                    {"units": "m", "long_name": "contactor position"},
                 ),
-                "mode": ("mode", np.arange(1, self.n_modes + 1)),
+                "mode": ("mode", np.arange(1, self.n_modes + 1, dtype=np.int32), {"long_name": "mode number"}),
+                "event": ("event", np.arange(len(self.events), dtype=np.int32), {"long_name": "event number"}),
             },
             attrs={
+                "Conventions": "CF-1.10",
                 "title": f"impactbeam simulation: {self.scenario_name}",
+                "history": f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')}: "
+                           f"impactbeam {__version__} simulate",
+                "source": f"impactbeam {__version__}: exact piecewise modal solution (closed form between exact "
+                          "events)",
+                "references": _REFERENCE,
                 "impactbeam_version": __version__,
                 "status": self.status,
                 "message": self.message,
                 "warnings": "; ".join(self.warnings),
                 "n_modes": self.n_modes,
                 "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
+                "scenario": self.scenario_text or "",
+                "metrics": metrics_json(self.metrics()),
                 **{f"solver_{k}": v for k, v in self.options.items()},
             },
         )
@@ -465,9 +513,7 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     check_output_size(result.time.size, result.points.size, len(result.contactors), result.n_modes)
     with atomic_path(path) as tmp:
         if suffix == ".nc":
-            ds = result.to_xarray()
-            ds.attrs["metrics"] = metrics_json(result.metrics())
-            ds.to_netcdf(tmp, engine="h5netcdf")
+            result.to_xarray().to_netcdf(tmp, engine="h5netcdf")
         elif suffix == ".csv":
             result.to_dataframe().to_csv(tmp, index=False)
         else:

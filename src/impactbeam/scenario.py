@@ -410,14 +410,17 @@ def dump_scenario(data: Mapping[str, Any], path: str | os.PathLike[str]) -> None
     Numpy values are converted; ``inf`` is written as the TOML float ``inf``.
     ``load_scenario(path)`` gives back the same scenario.
     """
+    write_text(path, scenario_toml(data))
+
+
+def scenario_toml(data: Mapping[str, Any]) -> str:
+    """The scenario mapping ``data`` as TOML text (what :func:`dump_scenario` writes)."""
     import tomli_w
 
-    raw = _normalise(data)
     try:
-        text = tomli_w.dumps(raw)
+        return tomli_w.dumps(_normalise(data))
     except (TypeError, ValueError) as exc:
         raise ScenarioError(f"cannot write the scenario as TOML: {exc}") from None
-    write_text(path, text)
 
 
 # --------------------------------------------------------------------------- value helpers
@@ -807,6 +810,10 @@ class Scenario:
     source: Path | None = None
     base_dir: Path | None = None
     name: str = "scenario"
+
+    def to_toml(self) -> str:
+        """The scenario as TOML text (``load_scenario`` of it gives the same scenario)."""
+        return scenario_toml(self.data)
 
     @property
     def description(self) -> str | None:

@@ -202,7 +202,7 @@ def simulate(
     are also listed in ``result.warnings``.
     """
     _require_scenario(scenario)
-    return simulate_system(
+    res = simulate_system(
         scenario.beam,
         scenario.contactors,
         damping=scenario.damping,
@@ -214,3 +214,5 @@ def simulate(
         progress=progress,
         name=scenario.name,
     )
+    object.__setattr__(res, "scenario_text", scenario.to_toml())
+    return res
