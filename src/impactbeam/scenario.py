@@ -253,7 +253,7 @@ def _normalise(value: Any, path: str = "") -> Any:
     Tuples and arrays become lists, numpy scalars Python scalars, paths
     strings; keys whose value is None are dropped (None means "not given").
     """
-    if isinstance(value, (str, float, int)):  # immutable leaves (bool is an int): nothing to copy
+    if type(value) in (str, float, int, bool):  # immutable plain leaves: nothing to copy (numpy scalars below)
         return value
     if isinstance(value, Mapping):
         out = {}
