@@ -348,3 +348,68 @@ def test_bad_structure_input_exits_2_naming_the_key(tmp_path, extra, key):
     path.write_text(CANTILEVER + extra)
     proc = run("modes", path)
     assert_one_error_line(proc, 2, key)
+
+
+# --------------------------------------------------------------------------- CLI and plot
+
+
+STRUCTURE = CANTILEVER + """
+[[beam.sections]]
+length = 0.4
+height = "14 mm"
+[[beam.sections]]
+length = 0.6
+[[masses]]
+position_ratio = 1.0
+mass = "50 g"
+rotary_inertia = 1e-6
+[[springs]]
+position = 0.5
+translational = 1e4
+rotational = "inf"
+[[contactors]]
+position = 0.8
+stiffness = 2e4
+gap = 1e-4
+"""
+
+
+def test_modes_cli_json_and_plot_of_a_structure(tmp_path):
+    import json
+
+    path = tmp_path / "s.toml"
+    path.write_text(STRUCTURE)
+    png = tmp_path / "modes.png"
+    proc = run("modes", path, "--json", "--plot", png)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    sc = ib.load_scenario(path)
+    ms = ib.modes(sc)
+    assert out["free"]["frequencies_hz"] == pytest.approx(ms.free.frequencies_hz.tolist(), rel=1e-12)
+    assert out["contact"]["frequencies_hz"] == pytest.approx(ms.contact.frequencies_hz.tolist(), rel=1e-12)
+    assert out["structure"] == {
+        "section_steps": [0.4],
+        "masses": [{"position": 1.0, "mass": 0.05, "rotary_inertia": 1e-6}],
+        "springs": [{"position": 0.5, "translational": 1e4, "rotational": "inf"}],
+    }
+    assert png.stat().st_size > 1000
+    # the table names the structure
+    table = run("modes", path).stdout
+    assert "2 sections, 1 point mass, 1 interior spring" in table
+
+
+def test_plot_modes_marks_the_structure():
+    from impactbeam import plot
+
+    sc = ib.parse_scenario(__import__("tomllib").loads(STRUCTURE))
+    ms = ib.modes(sc).free
+    h = plot.plot_modes(ms, count=4, contactors=sc.contactors)
+    assert len(h.lines) == 4
+    x, y = h.lines[1].get_data()
+    assert np.abs(y).max() == pytest.approx(1.0)  # scaled to the largest deflection
+    i = int(np.argmin(np.abs(x - 300.0)))
+    assert y[i] == pytest.approx(ms.shapes([x[i] / 1e3])[1, 0] / np.abs(ms.shapes(x / 1e3)[1]).max())
+    assert [ln.get_xdata()[0] for ln in h.artists["steps"]] == pytest.approx([400.0])
+    assert h.artists["springs"].get_xdata() == pytest.approx([500.0])
+    assert h.artists["masses"].get_xdata() == pytest.approx([1000.0])
+    assert h.artists["contactors"].get_xdata() == pytest.approx([800.0])
