@@ -413,3 +413,13 @@ def test_plot_modes_marks_the_structure():
     assert h.artists["springs"].get_xdata() == pytest.approx([500.0])
     assert h.artists["masses"].get_xdata() == pytest.approx([1000.0])
     assert h.artists["contactors"].get_xdata() == pytest.approx([800.0])
+
+
+def test_relay_example_against_fe():
+    # the example file of examples/README.md: parsed, and its exact modes (free and with
+    # the stop engaged) agree with the FE reference within the Richardson estimate
+    sc = ib.load_scenario(EXAMPLES / "relay_tip_mass.toml")
+    assert len(sc.beam.sections) == 2 and len(sc.beam.masses) == 1 and len(sc.beam.springs) == 1
+    _fe_compare(sc.beam, 6)
+    c = sc.contactors[0]
+    _fe_compare(sc.beam, 6, contact=((c.position, c.stiffness),))

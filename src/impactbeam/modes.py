@@ -1,34 +1,40 @@
-"""Exact modal analysis of a beam with elastic end supports and interior springs.
+"""Exact modal analysis of a beam with supports, steps, point masses and springs.
 
-The beam of :class:`~impactbeam.beam.Beam` with any set of engaged translational
-springs (the contact springs) is cut at the springs into ``s`` uniform segments.
-On each segment ``[x0, x1]`` (length ``l``) a mode shape is written in the
-bounded basis
+The beam of :class:`~impactbeam.beam.Beam` (piecewise uniform sections, point
+masses, permanent interior springs) with any set of engaged translational
+springs (the contact springs) is cut at every step, mass and spring into ``s``
+uniform segments. On each segment ``[x0, x1]`` (length ``l``, wavenumber
+``beta_j``) a mode shape is written in the bounded basis
 
-.. math:: W(x) = C_1 \\cos\\beta u + C_2 \\sin\\beta u + C_3 e^{-\\beta u} + C_4 e^{-\\beta (l - u)},
-          \\qquad u = x - x_0,
+.. math:: W(x) = C_1 \\cos\\beta_j u + C_2 \\sin\\beta_j u + C_3 e^{-\\beta_j u}
+          + C_4 e^{-\\beta_j (l - u)}, \\qquad u = x - x_0,
 
 which spans the same space as the paper's eq. (5) but never grows: every
-entry of the characteristic matrix is bounded by one, so the frequencies and
-shapes keep full precision up to hundreds of modes (the textbook
-``cosh - sigma sinh`` form loses every digit past mode ~12).
+entry of the characteristic matrix is bounded, so the frequencies and shapes
+keep full precision up to hundreds of modes (the textbook ``cosh - sigma
+sinh`` form loses every digit past mode ~12).
 
 The ``4 s`` conditions are the end conditions of the paper (after eq. 5),
 
 .. math:: K_{t1} W'(0) = EI W''(0), \\quad EI W'''(0) = -k_1 W(0),\\quad
           -K_{t2} W'(L) = EI W''(L), \\quad EI W'''(L) = k_2 W(L),
 
-and, at a spring ``k`` at ``x = a`` (paper, contact-state compatibilities),
-continuity of ``W, W', W''`` and ``EI (W'''(a^-) - W'''(a^+)) = k W(a)``. Each
-spring condition is written with the bounded weights ``p = K/(K + EI b)``,
-``q = 1 - p`` so that an infinite spring is exact (``p = 1, q = 0``).
+and at each interior node continuity of ``W, W'`` with the jumps
+``[EI W'']^+_- = (K_t - J omega^2) W'`` and ``-[EI W''']^+_- = (k - m omega^2) W``
+(a spring alone: the paper's contact-state compatibilities; a section step:
+continuity of ``EI W''`` and ``EI W'''``; point masses at an end enter the end
+conditions the same way). :mod:`impactbeam._exact` builds the matrix, counts
+and refines the roots.
 
 Every root is found exactly once: the Wittrick-Williams count
 ``J(omega) = sum J0 + s{K(omega)}`` (number of natural frequencies below
-``omega``, from the sign count of the exact dynamic stiffness matrix) brackets
-each root alone, and Brent's method refines it on the determinant of the
-characteristic matrix. Rigid-body modes (zero frequency) are found from the
-linear shapes the supports allow.
+``omega``, from the sign count of the exact dynamic stiffness matrix with the
+node terms ``k - m omega^2`` and ``K_t - J omega^2``) brackets each root alone,
+and Brent's method refines it on the determinant of the characteristic
+matrix. Rigid-body modes (zero frequency) are found from the linear shapes
+the supports allow. Shapes are orthonormal in the kinetic-energy inner
+product ``int rho A W W dx + sum_j (m_j W W + J_j W' W')``, which is also the
+projection of eq. (12) between states.
 
 References
 ----------
@@ -86,14 +92,16 @@ class ModeSet:
     omega : ndarray, shape (n,), [rad/s]
         Natural circular frequencies, ascending; 0 for rigid-body modes.
     beta : ndarray, shape (n,), [1/m]
-        Wavenumbers, ``omega = beta^2 sqrt(EI / rho A)`` (paper, after eq. 5).
+        Wavenumbers of the reference (``[beam]``) section, ``omega = beta^2 sqrt(EI / rho A)``
+        (paper, after eq. 5); a segment of a stepped beam has ``beta_j = r_j beta``.
     n_rigid : int
         Number of rigid-body modes (they come first).
 
     Notes
     -----
-    Shapes are normalised so that ``rho A int W_n W_m dx = delta_nm`` (paper,
-    orthonormality after eq. 7); their sign makes the largest displacement
+    Shapes are normalised so that ``int rho A W_n W_m dx = delta_nm`` (paper,
+    orthonormality after eq. 7; plus ``m_j W_n W_m + J_j W_n' W_m'`` at point
+    masses); their sign makes the largest displacement
     positive.
     """
 
