@@ -171,6 +171,20 @@ class ModeSet:
             out[r:] = val * b**derivative
         return out
 
+    def moment_shapes(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """Bending moment per unit modal coordinate, ``EI(x) W_n''(x)`` [N m kg^-0.5], shape (n, p).
+
+        ``M(x, t) = sum_n eta_n(t) EI(x) W_n''(x)`` (sign: positive for
+        ``w'' > 0``); the outer-fibre stress is ``M c(x) / I(x)`` with
+        :meth:`~impactbeam.beam.Beam.fibre_distance_at` and
+        :meth:`~impactbeam.beam.Beam.second_moment_at`. A plain modal sum of
+        moments converges slowly near loads and stops (a static correction
+        helps there). At a step the section to the right is used on both
+        sides of ``x`` alike, which is exact since ``EI W''`` is continuous.
+        """
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        return self.beam.bending_stiffness_at(x)[None, :] * self.shapes(x, 2)
+
     def __call__(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
         """Same as :meth:`shapes` with ``derivative=0``."""
         return self.shapes(x)
