@@ -431,7 +431,7 @@ def test_moment_shapes_reproduce_the_static_moment_of_a_stepped_cantilever():
     # converges algebraically in N, slowest near the load. Requirement: the error of 100
     # modes is within twice the 100 -> 200 change (a convergence rate of N^-1 or faster
     # makes it so), and 200 modes are within 1e-4 relative (measured: 8e-7 at the clamp,
-    # ? at x = 0.75, a quarter of the length from the load).
+    # 2.8e-5 at x = 0.75, a quarter of the length from the load; 100 modes: 3.3e-6, 1.5e-4).
     beam = _steel(sections=STEPPED, masses=(PointMass(0.6, 0.1, 1e-5),))
     x = np.array([0.0, 0.3, 0.5, 0.75])
     exact = 2.0 * (1.0 - x)
