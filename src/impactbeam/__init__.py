@@ -6,7 +6,7 @@ transient response of an impacting beam", Shock and Vibration 20 (2013).
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .beam import Beam, Contactor, Support
+from .beam import Beam, Contactor, InteriorSpring, PointMass, Section, Support
 from .exceptions import (
     ImpactBeamError,
     ModeSolveError,
@@ -28,6 +28,9 @@ __all__ = [
     "Beam",
     "Contactor",
     "Support",
+    "Section",
+    "PointMass",
+    "InteriorSpring",
     "Excitation",
     "InitialCondition",
     "Damping",
