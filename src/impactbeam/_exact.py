@@ -154,6 +154,7 @@ def _joint_terms(lay: Layout, beta: float) -> tuple[np.ndarray, np.ndarray]:
 _KRYLOV_LIMIT = 1.5  # segments with beta l below this use the Krylov-Duncan basis
 _KRYLOV_TERMS = 9
 _FACT = np.array([math.factorial(n) for n in range(4 * _KRYLOV_TERMS + 4)], dtype=float)
+_POWERS = np.arange(4 * _KRYLOV_TERMS + 4, dtype=float)
 
 
 def _krylov(z: np.ndarray, deriv: int) -> tuple[np.ndarray, ...]:
@@ -202,12 +203,26 @@ def _basis(z: np.ndarray, zl: np.ndarray, deriv: int, krylov: np.ndarray | bool 
 
 
 def _basis_row(z: float, zl: float, krylov: bool) -> np.ndarray:
-    """Scaled derivatives 0..3 of the 4 basis functions at a point: shape (4 derivs, 4 functions)."""
-    out = np.empty((4, 4))
-    for d in range(4):
-        out[d] = np.array(_basis(np.asarray(z), np.asarray(zl), d, krylov), dtype=float)
-    return out
+    """Scaled derivatives 0..3 of the 4 basis functions at a point: shape (4 derivs, 4 functions).
 
+    The scalar form of :func:`_basis` (the same values), written out because
+    the characteristic matrix and the dynamic stiffness call it for every node.
+    """
+    out = np.empty((4, 4))
+    z = float(z)
+    if krylov:
+        q = z**_POWERS / _FACT[: _POWERS.size]
+        for d in range(4):
+            for j in range(4):
+                out[d, j] = q[(j - d) % 4 :: 4][:_KRYLOV_TERMS][::-1].sum()
+        return out
+    c, s = math.cos(z), math.sin(z)
+    e1, e2 = math.exp(-z), math.exp(-(float(zl) - z))
+    out[0] = (c, s, e1, e2)
+    out[1] = (-s, c, -e1, e2)
+    out[2] = (-c, -s, e1, e2)
+    out[3] = (s, -c, -e1, e2)
+    return out
 
 
 # --------------------------------------------------------------------------- characteristic matrix
