@@ -418,7 +418,7 @@ def test_plot_modes_marks_the_structure():
 def test_relay_example_against_fe():
     # the example file of examples/README.md: parsed, and its exact modes (free and with
     # the stop engaged) agree with the FE reference within the Richardson estimate
-    sc = ib.load_scenario(EXAMPLES / "relay_tip_mass.toml")
+    sc = ib.load_scenario(EXAMPLES / "structures" / "relay_tip_mass.toml")
     assert len(sc.beam.sections) == 2 and len(sc.beam.masses) == 1 and len(sc.beam.springs) == 1
     _fe_compare(sc.beam, 6)
     c = sc.contactors[0]
