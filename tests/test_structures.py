@@ -22,15 +22,15 @@ import dataclasses
 import math
 from pathlib import Path
 
+import fe_reference as fr
 import numpy as np
 import pytest
 from scipy.optimize import brentq
+from test_cli_input import assert_one_error_line, run
 
-import fe_reference as fr
 import impactbeam as ib
 from impactbeam.beam import InteriorSpring, PointMass, Section
 from impactbeam.modes import count_below
-from test_cli_input import assert_one_error_line, run
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 INF = math.inf

@@ -15,8 +15,8 @@ deflection ``w`` is measured from the undeformed rest position. A contactor
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np

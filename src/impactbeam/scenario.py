@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import copy
 import csv
+import dataclasses
 import difflib
 import io
 import math
@@ -32,7 +33,6 @@ import re
 import tomllib
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
-import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -42,7 +42,15 @@ import numpy as np
 from ._atomic import write_text
 from ._textdata import read_data_lines
 from ._validation import choice, nonnegative_finite, positive_finite
-from .beam import SUPPORT_PRESETS, Beam, Contactor, InteriorSpring, PointMass, Section, Support
+from .beam import (
+    SUPPORT_PRESETS,
+    Beam,
+    Contactor,
+    InteriorSpring,
+    PointMass,
+    Section,
+    Support,
+)
 from .exceptions import ParameterError, ScenarioError
 from .loading import Excitation, InitialCondition
 from .solver.options import Damping, SolverOptions
