@@ -178,6 +178,7 @@ class FEModel:
     K_r: np.ndarray = field(repr=False)
     M_r: np.ndarray = field(repr=False)
     spring_diag: np.ndarray = field(repr=False, default=None)
+    EI_el: np.ndarray | None = field(repr=False, default=None)  # per element (stepped beams)
 
     @property
     def n_nodes(self) -> int:
@@ -252,8 +253,11 @@ def assemble(
     right: tuple[float, float] = (0.0, 0.0),
     springs: Sequence[tuple[float, float]] = (),
     nodes_at: Sequence[float] = (),
+    sections: Sequence[tuple[float, float, float]] = (),
+    masses: Sequence[tuple[float, float, float]] = (),
+    rotational_springs: Sequence[tuple[float, float]] = (),
 ) -> FEModel:
-    """Assemble K and M of a uniform Hermite-cubic beam.
+    """Assemble K and M of a Hermite-cubic beam (uniform, or piecewise uniform).
 
     Parameters
     ----------
@@ -263,18 +267,37 @@ def assemble(
         ``w`` at that node.  Springs at the same x add up.
     nodes_at : further x positions that must be mesh nodes (contactors,
         output points...).
+    sections : ``(length, EI, rhoA)`` pieces from x = 0 (lengths summing to
+        ``length``); empty: uniform ``EI``, ``rhoA``. Every step is a mesh node.
+    masses : ``(x, m, J)`` point masses (lumped: ``m`` on ``w``, ``J`` on
+        ``theta`` of the node at x).
+    rotational_springs : interior rotational springs ``(x, kt)`` on ``theta``
+        (``inf`` constrains it).
 
     Returns an :class:`FEModel`.
     """
     if EI <= 0 or rhoA <= 0:
         raise ValueError("EI and rhoA must be positive")
     springs = [(float(x), _check_spring(k, "spring stiffness")) for x, k in springs]
-    x = build_mesh(length, n_elements, [s[0] for s in springs] + [float(p) for p in nodes_at])
+    rot = [(float(x), _check_spring(k, "rotational spring")) for x, k in rotational_springs]
+    steps = list(np.cumsum([sec[0] for sec in sections])[:-1]) if sections else []
+    x = build_mesh(
+        length, n_elements,
+        [s[0] for s in springs] + [r[0] for r in rot] + [m[0] for m in masses]
+        + [float(p) for p in steps] + [float(p) for p in nodes_at],
+    )
     n = len(x)
     K = np.zeros((2 * n, 2 * n))
     M = np.zeros((2 * n, 2 * n))
+    EI_el = np.full(n - 1, float(EI))
+    edges = np.concatenate([[0.0], np.cumsum([sec[0] for sec in sections])]) if sections else None
     for e in range(n - 1):
-        ke, me = element_matrices(x[e + 1] - x[e], EI, rhoA)
+        EI_e, rhoA_e = EI, rhoA
+        if sections:
+            j = int(np.clip(np.searchsorted(edges, 0.5 * (x[e] + x[e + 1])) - 1, 0, len(sections) - 1))
+            EI_e, rhoA_e = sections[j][1], sections[j][2]
+        EI_el[e] = EI_e
+        ke, me = element_matrices(x[e + 1] - x[e], EI_e, rhoA_e)
         sl = slice(2 * e, 2 * e + 4)
         K[sl, sl] += ke
         M[sl, sl] += me
@@ -297,11 +320,18 @@ def assemble(
     model_tmp = FEModel(length, EI, rhoA, x, K, M, np.arange(2 * n), K, M)
     for xs, k in springs:
         add(2 * model_tmp.node_index(xs), k)
+    for xs, k in rot:
+        add(2 * model_tmp.node_index(xs) + 1, k)
+    for xs, m, J in masses:
+        i = model_tmp.node_index(xs)
+        M[2 * i, 2 * i] += m
+        M[2 * i + 1, 2 * i + 1] += J
     free = np.array(sorted(set(range(2 * n)) - constrained), dtype=int)
     K_r = K[np.ix_(free, free)].copy()
     M_r = M[np.ix_(free, free)].copy()
     spring_diag[sorted(constrained)] = 0.0
-    return FEModel(float(length), float(EI), float(rhoA), x, K, M, free, K_r, M_r, spring_diag)
+    return FEModel(float(length), float(EI), float(rhoA), x, K, M, free, K_r, M_r, spring_diag,
+                   EI_el if sections else None)
 
 
 # --------------------------------------------------------------------------
@@ -338,7 +368,8 @@ def strain_energy(model: FEModel, u: np.ndarray) -> np.ndarray:
     d = (w[1:] - w[:-1]) / l
     k0 = (6 * d - 4 * th[:-1] - 2 * th[1:]) / l
     k1 = (-6 * d + 2 * th[:-1] + 4 * th[1:]) / l
-    beam = model.EI * np.sum(l / 6.0 * (k0 * k0 + k0 * k1 + k1 * k1), axis=0)
+    EI = model.EI if model.EI_el is None else (model.EI_el if u.ndim == 1 else model.EI_el[:, None])
+    beam = np.sum(EI * l / 6.0 * (k0 * k0 + k0 * k1 + k1 * k1), axis=0)
     sp = model.spring_diag if u.ndim == 1 else model.spring_diag[:, None]
     return beam + 0.5 * np.sum(sp * u * u, axis=0)
 
@@ -396,6 +427,7 @@ def fe_modes(
     springs: Sequence[tuple[float, float]] = (),
     n_modes: int = 10,
     nodes_at: Sequence[float] = (),
+    **structure: Sequence,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """FE natural frequencies and mode shapes.
 
@@ -404,10 +436,11 @@ def fe_modes(
     ``shapes`` (n_modes, n_nodes) the nodal deflection ``w`` of each
     mass-normalised mode (``shapes[j]`` is mode j; rhoA int W^2 dx = 1 in the
     FE sense), largest |w| positive; ``x`` (n_nodes,) node coordinates.
+    ``structure``: ``sections``, ``masses``, ``rotational_springs`` of :func:`assemble`.
     """
     model = assemble(
         length, EI, rhoA, n_elements=n_elements, left=left, right=right,
-        springs=springs, nodes_at=nodes_at,
+        springs=springs, nodes_at=nodes_at, **structure,
     )
     omega, full = solve_modes(model, n_modes)
     return omega, full[0::2].T.copy(), model.x.copy()
@@ -487,6 +520,7 @@ def fe_transient(
     t_end: float,
     output_x: Sequence[float] | None = None,
     n_elements: int = 50,
+    **structure: Sequence,
 ) -> TransientResult:
     """Newmark (average acceleration) transient response with one-sided contactors.
 
@@ -549,7 +583,7 @@ def fe_transient(
         extra_nodes.append(load["position"])
     model = assemble(
         length, EI, rhoA, n_elements=n_elements, left=left, right=right,
-        springs=springs, nodes_at=extra_nodes,
+        springs=springs, nodes_at=extra_nodes, **structure,
     )
     free = model.free
     Kr, Mr = model.K_r, model.M_r

@@ -18,6 +18,9 @@ _EXPORTS: dict[str, str] = {
     "Beam": "beam",
     "Contactor": "beam",
     "Support": "beam",
+    "Section": "beam",
+    "PointMass": "beam",
+    "InteriorSpring": "beam",
     "Excitation": "loading",
     "InitialCondition": "loading",
     "Damping": "solver",
@@ -48,7 +51,7 @@ _EXPORTS: dict[str, str] = {
 __all__ = [*_EXPORTS, "modes", "sweep", "__version__"]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
-    from .beam import Beam, Contactor, Support
+    from .beam import Beam, Contactor, InteriorSpring, PointMass, Section, Support
     from .exceptions import (
         ImpactBeamError,
         ImpactBeamWarning,

@@ -1,4 +1,10 @@
-"""The physical system: a uniform Euler-Bernoulli beam, its end supports and contactors.
+"""The physical system: an Euler-Bernoulli beam, its supports, attachments and contactors.
+
+The beam of the paper is uniform with springs at its ends; a :class:`Beam` may
+also be piecewise uniform (:class:`Section`), carry point masses
+(:class:`PointMass`) and rest on permanent interior springs
+(:class:`InteriorSpring`). These change only the segments and joint
+conditions of the exact modal analysis (:mod:`impactbeam.modes`).
 
 All quantities are SI. The sign convention (DESIGN.md section 1) is that the
 deflection ``w`` is measured from the undeformed rest position. A contactor
@@ -9,13 +15,16 @@ deflection ``w`` is measured from the undeformed rest position. A contactor
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
+
+import numpy as np
 
 from ._validation import choice, nonnegative_finite, positive_finite, stiffness
 from .exceptions import ParameterError
 
-__all__ = ["Support", "Beam", "Contactor", "SUPPORT_PRESETS", "Side"]
+__all__ = ["Support", "Beam", "Contactor", "Section", "PointMass", "InteriorSpring", "SUPPORT_PRESETS", "Side"]
 
 Side = Literal["below", "above"]
 
@@ -70,8 +79,91 @@ class Support:
 
 
 @dataclass(frozen=True)
+class Section:
+    """One uniform piece of a stepped beam (``[[beam.sections]]``).
+
+    Parameters
+    ----------
+    length : float, [m]
+    youngs_modulus : float, [Pa]
+    density : float, [kg/m^3]
+    area : float, [m^2]
+    second_moment : float, [m^4]
+    width, height : float or None, [m]
+        Rectangle dimensions when known; ``height / 2`` is the outer-fibre distance.
+    """
+
+    length: float
+    youngs_modulus: float
+    density: float
+    area: float
+    second_moment: float
+    width: float | None = None
+    height: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("length", "youngs_modulus", "density", "area", "second_moment"):
+            object.__setattr__(self, name, positive_finite(f"section.{name}", getattr(self, name)))
+
+    @property
+    def bending_stiffness(self) -> float:
+        """EI [N m^2]."""
+        return self.youngs_modulus * self.second_moment
+
+    @property
+    def mass_per_length(self) -> float:
+        """rho A [kg/m]."""
+        return self.density * self.area
+
+
+@dataclass(frozen=True)
+class PointMass:
+    """A rigid body attached at one point (``[[masses]]``): shear jump ``-m w^2 W``, moment jump ``-J w^2 W'``.
+
+    Parameters
+    ----------
+    position : float, [m]
+    mass : float, [kg]
+    rotary_inertia : float, [kg m^2]
+        About the axis normal to the plane of bending, through the attachment point.
+    """
+
+    position: float
+    mass: float
+    rotary_inertia: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "position", nonnegative_finite("mass.position", self.position))
+        object.__setattr__(self, "mass", nonnegative_finite("mass.mass", self.mass))
+        object.__setattr__(self, "rotary_inertia", nonnegative_finite("mass.rotary_inertia", self.rotary_inertia))
+
+
+@dataclass(frozen=True)
+class InteriorSpring:
+    """A permanent two-sided support at one point (``[[springs]]``), unlike a one-sided contactor.
+
+    Parameters
+    ----------
+    position : float, [m]
+    translational : float, [N/m]
+        0 = none, inf = rigid (a pin).
+    rotational : float, [N m/rad]
+        0 = none, inf = rigid (no rotation at the point).
+    """
+
+    position: float
+    translational: float = 0.0
+    rotational: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "position", nonnegative_finite("spring.position", self.position))
+        object.__setattr__(self, "translational", stiffness("spring.translational", self.translational))
+        object.__setattr__(self, "rotational", stiffness("spring.rotational", self.rotational))
+
+
+@dataclass(frozen=True)
 class Beam:
-    """Uniform Euler-Bernoulli beam with elastic end supports (paper eq. 1).
+    """Euler-Bernoulli beam with elastic end supports (paper eq. 1), optionally stepped.
 
     Parameters
     ----------
@@ -85,6 +177,12 @@ class Beam:
     width, height : float or None, [m]
         Cross-section dimensions when the beam was built as a rectangle
         (kept for reporting and for parameter studies).
+    sections : tuple of Section
+        Piecewise-uniform properties from x = 0; empty: uniform with the
+        values above. The lengths must sum to ``length``.
+    masses : tuple of PointMass
+    springs : tuple of InteriorSpring
+        Permanent interior (or end) springs, added to the end supports at an end.
     """
 
     length: float
@@ -96,6 +194,9 @@ class Beam:
     right: Support = field(default_factory=lambda: Support.preset("free"))
     width: float | None = None
     height: float | None = None
+    sections: tuple[Section, ...] = ()
+    masses: tuple[PointMass, ...] = ()
+    springs: tuple[InteriorSpring, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("length", "youngs_modulus", "density", "area", "second_moment"):
@@ -103,6 +204,25 @@ class Beam:
         for name in ("left", "right"):
             if not isinstance(getattr(self, name), Support):
                 raise ParameterError(f"beam.{name}: expected a Support, got {getattr(self, name)!r}")
+        for name, kind in (("sections", Section), ("masses", PointMass), ("springs", InteriorSpring)):
+            items = tuple(getattr(self, name))
+            for i, item in enumerate(items):
+                if not isinstance(item, kind):
+                    raise ParameterError(f"beam.{name}[{i}]: expected a {kind.__name__}, got {item!r}")
+            object.__setattr__(self, name, items)
+        if self.sections:
+            total = math.fsum(sec.length for sec in self.sections)
+            if abs(total - self.length) > 1e-9 * self.length:
+                raise ParameterError(
+                    f"beam.sections: the section lengths sum to {total:.12g} m, not beam.length = {self.length:.12g} m"
+                )
+        tol = 1e-12 * self.length
+        for name in ("masses", "springs"):
+            for i, item in enumerate(getattr(self, name)):
+                if item.position > self.length + tol:
+                    raise ParameterError(
+                        f"{name}[{i}].position: {item.position:g} m is off the beam (length {self.length:g} m)"
+                    )
 
     @classmethod
     def rectangular(
@@ -129,8 +249,54 @@ class Beam:
 
     @property
     def mass_per_length(self) -> float:
-        """rho A [kg/m]."""
+        """rho A [kg/m] of the ``[beam]`` values (the reference section of a stepped beam)."""
         return self.density * self.area
+
+    @property
+    def is_uniform(self) -> bool:
+        """True for the paper's beam: one section, no masses, no interior springs."""
+        return not (self.sections or self.masses or self.springs)
+
+    def pieces(self) -> tuple[Section, ...]:
+        """The uniform pieces from x = 0 (one piece with the ``[beam]`` values if not stepped)."""
+        if self.sections:
+            return self.sections
+        return (Section(self.length, self.youngs_modulus, self.density, self.area, self.second_moment,
+                        self.width, self.height),)
+
+    def _piece_values(self, x: float | Sequence[float] | np.ndarray, attr: str) -> np.ndarray:
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        pieces = self.pieces()
+        ends = np.cumsum([p.length for p in pieces])[:-1]
+        idx = np.searchsorted(ends, x, side="right")
+        vals = np.array([np.nan if getattr(p, attr) is None else float(getattr(p, attr)) for p in pieces])
+        return vals[idx]
+
+    def bending_stiffness_at(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """EI(x) [N m^2]; at a step, the value of the section to the right."""
+        return self._piece_values(x, "youngs_modulus") * self._piece_values(x, "second_moment")
+
+    def second_moment_at(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """I(x) [m^4]; at a step, the value of the section to the right."""
+        return self._piece_values(x, "second_moment")
+
+    def mass_per_length_at(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """rho A(x) [kg/m]; at a step, the value of the section to the right."""
+        return self._piece_values(x, "density") * self._piece_values(x, "area")
+
+    def fibre_distance_at(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """Outer-fibre distance c(x) = height / 2 [m] (NaN where the section was given as area and I).
+
+        The bending stress is ``sigma = M c / I`` with ``M = EI W''``.
+        """
+        return 0.5 * self._piece_values(x, "height")
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the beam and its point masses [kg]."""
+        return math.fsum(p.mass_per_length * p.length for p in self.pieces()) + math.fsum(
+            m.mass for m in self.masses
+        )
 
 
 @dataclass(frozen=True)

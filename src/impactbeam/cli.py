@@ -215,12 +215,16 @@ def main() -> None:
 @click.option("--count", "count", type=int, default=None,
               help="Number of modes per state [default: the scenario's solver.modes].")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
+@click.option("--plot", "plot_path", default=None, metavar="FILE.png",
+              help="Draw the free-state mode shapes with steps, springs, masses and contactors marked.")
 @handle_errors
-def modes(scenario: str, count: int | None, as_json: bool) -> None:
+def modes(scenario: str, count: int | None, as_json: bool, plot_path: str | None = None) -> None:
     """Natural frequencies of the free and the contact state.
 
     The contact state has every contactor engaged; it is omitted without
-    contactors.
+    contactors. Section steps, point masses and permanent springs
+    (``[[beam.sections]]``, ``[[masses]]``, ``[[springs]]``) belong to both
+    states; the JSON then has a ``structure`` entry listing them.
     """
     from .solver.options import MAX_MODES
 
@@ -235,18 +239,43 @@ def modes(scenario: str, count: int | None, as_json: bool) -> None:
     ms = scenario_modes(sc, n)
     free = [float(f) for f in ms.free.frequencies_hz]
     contact = None if ms.contact is None else [float(f) for f in ms.contact.frequencies_hz]
+    if plot_path is not None:
+        from .plot import plot_modes
+
+        plot_modes(ms.free, count=min(n, 6), contactors=sc.contactors, path=plot_path,
+                   title=f"{sc.name}: free-state mode shapes")
     if as_json:
         out: dict[str, Any] = {"free": {"frequencies_hz": free}}
         if contact is not None:
             out["contact"] = {"frequencies_hz": contact}
+        if not sc.beam.is_uniform:
+            out["structure"] = _structure(sc.beam)
         click.echo(_dumps(out))
         return
     click.echo(_modes_table(sc, ms, free, contact))
 
 
+def _structure(beam: Any) -> dict[str, Any]:
+    """Steps, point masses and permanent springs of a beam, for the JSON of ``modes`` (SI; "inf" = rigid)."""
+    lengths = [p.length for p in beam.pieces()]
+    rigid = lambda k: "inf" if math.isinf(k) else k  # noqa: E731 - the scenario's spelling of a rigid spring
+    return {
+        "section_steps": [math.fsum(lengths[: i + 1]) for i in range(len(lengths) - 1)],
+        "masses": [{"position": m.position, "mass": m.mass, "rotary_inertia": m.rotary_inertia} for m in beam.masses],
+        "springs": [{"position": s.position, "translational": rigid(s.translational), "rotational": rigid(s.rotational)}
+                    for s in beam.springs],
+    }
+
+
 def _modes_table(sc: Any, ms: Any, free: list[float], contact: list[float] | None) -> str:
     n_contactors = len(sc.contactors)
     title = f"Natural frequencies of {sc.name!r}: {sc.beam.left.describe()}-{sc.beam.right.describe()} beam"
+    b = sc.beam
+    extras = [f"{len(b.sections)} sections" if b.sections else "",
+              f"{len(b.masses)} point mass{'es' if len(b.masses) > 1 else ''}" if b.masses else "",
+              f"{len(b.springs)} interior spring{'s' if len(b.springs) > 1 else ''}" if b.springs else ""]
+    if any(extras):
+        title += " with " + ", ".join(e for e in extras if e)
     if n_contactors:
         title += f", {n_contactors} contactor{'s' if n_contactors > 1 else ''} (contact state: all engaged)"
     rows = max(len(free), len(contact or []))

@@ -260,7 +260,13 @@ def time_pieces(excitation: Excitation, end_time: float) -> list[TimePiece]:
     return out
 
 
-def spatial_projection(excitation: Excitation, shapes_at, integral: np.ndarray, rho_a: float) -> np.ndarray:
+def spatial_projection(
+    excitation: Excitation,
+    shapes_at,
+    integral: np.ndarray,
+    rho_a: float,
+    inertia: np.ndarray | None = None,
+) -> np.ndarray:
     """Modal weights ``p_n`` with ``<f(., t), W_n> = p_n u(t)`` (paper eq. 8).
 
     Parameters
@@ -271,8 +277,16 @@ def spatial_projection(excitation: Excitation, shapes_at, integral: np.ndarray, 
         ``int W_n dx`` of the state.
     rho_a : float
         Mass per length; base acceleration is the load ``-rho A ug''(t)``.
+    inertia : ndarray, (n,), optional
+        ``int rho A(x) W_n dx + sum_j m_j W_n(x_j)``
+        (:meth:`~impactbeam.modes.ModeSet.inertia_integral`): the base
+        acceleration weight of a stepped beam or one carrying point masses.
+        When given it replaces ``rho_a * integral``; without it a beam with
+        masses or sections would get a wrong load, so pass it always.
     """
     if excitation.kind == "base_acceleration":
+        if inertia is not None:
+            return -np.asarray(inertia, dtype=float)
         return -rho_a * integral
     if excitation.kind == "distributed_force":
         return integral.copy()

@@ -23,6 +23,7 @@ The file format is described in ``examples/README.md``.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import difflib
 import math
 import os
@@ -40,7 +41,15 @@ from ._atomic import write_text
 from ._checks import check_magnitudes, warn_numeric_strings, warn_unusual
 from ._textdata import numeric_columns, read_delimited
 from ._validation import choice, nonnegative_finite, positive_finite
-from .beam import SUPPORT_PRESETS, Beam, Contactor, Support
+from .beam import (
+    SUPPORT_PRESETS,
+    Beam,
+    Contactor,
+    InteriorSpring,
+    PointMass,
+    Section,
+    Support,
+)
 from .exceptions import ParameterError, ScenarioError
 from .loading import Excitation, InitialCondition
 from .solver.options import Damping, SolverOptions
@@ -108,12 +117,19 @@ _SCHEMA = _Table(
         "name": _Leaf(),
         "description": _Leaf(),
         "beam": _Table(
-            _leaves(
-                "length", "width", "height", "area", "second_moment", "youngs_modulus", "density"
-            )
+            {
+                **_leaves("length", "width", "height", "area", "second_moment", "youngs_modulus", "density"),
+                "sections": _Array(
+                    _Table(
+                        _leaves("length", "width", "height", "area", "second_moment", "youngs_modulus", "density")
+                    )
+                ),
+            }
         ),
         "supports": _Table({"left": _SUPPORT_NODE, "right": _SUPPORT_NODE}),
         "contactors": _Array(_Table(_leaves("position", "position_ratio", "stiffness", "gap", "side"))),
+        "masses": _Array(_Table(_leaves("position", "position_ratio", "mass", "rotary_inertia"))),
+        "springs": _Array(_Table(_leaves("position", "position_ratio", "translational", "rotational"))),
         "damping": _Table(_leaves("free", "contact", list_ok=True)),
         "excitation": _Table(
             _leaves(
@@ -552,6 +568,82 @@ def _parse_support(value: Any, key: str) -> Support:
 
 
 def _parse_beam(raw: Mapping[str, Any]) -> Beam:
+    """The ``[beam]`` table with its supports, ``[[beam.sections]]``, ``[[masses]]`` and ``[[springs]]``."""
+    beam = _parse_uniform_beam(raw)
+    sections = _parse_sections(raw["beam"], beam)
+    masses, springs = _parse_attachments(raw, beam.length)
+    with _relabel("beam", (("beam.sections", "beam.sections"),)):
+        return dataclasses.replace(beam, sections=sections, masses=masses, springs=springs)
+
+
+def _parse_sections(b: Mapping[str, Any], beam: Beam) -> tuple[Section, ...]:
+    """``[[beam.sections]]``: each overrides the ``[beam]`` section values on its length."""
+    out = []
+    for i, sec in enumerate(b.get("sections", [])):
+        prefix = f"beam.sections.{i}"
+        _required(sec, prefix, "length")
+        length = _positive(sec, prefix, "length", "length")
+        modulus = _positive(sec, prefix, "youngs_modulus", "modulus") if "youngs_modulus" in sec else beam.youngs_modulus
+        density = _positive(sec, prefix, "density", "density") if "density" in sec else beam.density
+        rect = [n for n in ("width", "height") if n in sec]
+        given = [n for n in ("area", "second_moment") if n in sec]
+        if rect and given:
+            raise ScenarioError(
+                f"{prefix}.{given[0]}: give either width/height or area/second_moment, not both", key=f"{prefix}.{given[0]}"
+            )
+        width, height = beam.width, beam.height
+        area, second = beam.area, beam.second_moment
+        if rect:
+            if width is None and len(rect) < 2:
+                other = "width" if "width" not in sec else "height"
+                _required(sec, prefix, other, " ([beam] gives no rectangle to take it from)")
+            width = _positive(sec, prefix, "width", "length") if "width" in sec else width
+            height = _positive(sec, prefix, "height", "length") if "height" in sec else height
+            area, second = width * height, width * height**3 / 12.0
+        elif given:
+            area = _positive(sec, prefix, "area", "area") if "area" in sec else area
+            second = _positive(sec, prefix, "second_moment", "second_moment") if "second_moment" in sec else second
+            width = height = None
+        out.append(Section(length, modulus, density, area, second, width, height))
+    if out:
+        total = math.fsum(sec.length for sec in out)
+        if abs(total - beam.length) > 1e-9 * beam.length:
+            raise ScenarioError(
+                f"beam.sections: the section lengths sum to {total:.10g} m, not beam.length = {beam.length:.10g} m",
+                key="beam.sections",
+            )
+    return tuple(out)
+
+
+def _parse_attachments(
+    raw: Mapping[str, Any], length: float
+) -> tuple[tuple[PointMass, ...], tuple[InteriorSpring, ...]]:
+    """``[[masses]]`` (point masses) and ``[[springs]]`` (permanent supports)."""
+    masses = []
+    for i, m in enumerate(raw.get("masses", [])):
+        prefix = f"masses.{i}"
+        position = _position(m, prefix, length, required=True)
+        _required(m, prefix, "mass")
+        mass = _nonnegative(f"{prefix}.mass", m["mass"], "mass")
+        inertia = _nonnegative(f"{prefix}.rotary_inertia", m.get("rotary_inertia", 0.0), "rotary_inertia")
+        masses.append(PointMass(position, mass, inertia))
+    springs = []
+    for i, sp in enumerate(raw.get("springs", [])):
+        prefix = f"springs.{i}"
+        position = _position(sp, prefix, length, required=True)
+        if "translational" not in sp and "rotational" not in sp:
+            raise ScenarioError(f"{prefix}.translational: required (or rotational)", key=f"{prefix}.translational")
+        vals = {}
+        for name, dimension in (("translational", "stiffness"), ("rotational", "rotational_stiffness")):
+            key = f"{prefix}.{name}"
+            vals[name] = to_si(sp.get(name, 0.0), dimension, key)
+            if not vals[name] >= 0.0:
+                raise ScenarioError(f"{key}: must be >= 0 (0 = none, inf = rigid), got {vals[name]!r}", key=key)
+        springs.append(InteriorSpring(position, vals["translational"], vals["rotational"]))
+    return tuple(masses), tuple(springs)
+
+
+def _parse_uniform_beam(raw: Mapping[str, Any]) -> Beam:
     if "beam" not in raw:
         raise ScenarioError("beam: the [beam] table is required", key="beam")
     b = raw["beam"]

@@ -123,10 +123,12 @@ _PARAM_KEYS = ("values", "range", "scale", "distribution", "low", "high", "mean"
 _OUTPUT_KEYS = ("metrics", "histories")
 _HISTORY_KEYS = ("points", "time_step")
 
-# Parameters that determine the mode sets (beam, supports, spring positions and
-# stiffnesses, number of modes): cases sharing them reuse impactbeam.mode_set's cache.
+# Parameters that determine the mode sets (beam and its sections, supports, point masses,
+# permanent springs, contact spring positions and stiffnesses, number of modes): cases
+# sharing them reuse impactbeam.mode_set's cache.
 _GEOMETRY = re.compile(
-    r"^(beam(\..*)?|supports(\..*)?|contactors(\.\d+(\.(position|position_ratio|stiffness))?)?|solver\.modes)$"
+    r"^(beam(\..*)?|supports(\..*)?|masses(\..*)?|springs(\..*)?"
+    r"|contactors(\.\d+(\.(position|position_ratio|stiffness))?)?|solver\.modes)$"
 )
 
 # Physical dimension of each scenario path (used to read "0.2 mm" and to label coordinates).
@@ -136,6 +138,17 @@ _PATH_DIMENSIONS: tuple[tuple[str, str], ...] = (
     (r"beam\.second_moment", "second_moment"),
     (r"beam\.youngs_modulus", "modulus"),
     (r"beam\.density", "density"),
+    (r"beam\.sections\.\d+\.(length|width|height)", "length"),
+    (r"beam\.sections\.\d+\.area", "area"),
+    (r"beam\.sections\.\d+\.second_moment", "second_moment"),
+    (r"beam\.sections\.\d+\.youngs_modulus", "modulus"),
+    (r"beam\.sections\.\d+\.density", "density"),
+    (r"(masses|springs)\.\d+\.position", "length"),
+    (r"(masses|springs)\.\d+\.position_ratio", "dimensionless"),
+    (r"masses\.\d+\.mass", "mass"),
+    (r"masses\.\d+\.rotary_inertia", "rotary_inertia"),
+    (r"springs\.\d+\.translational", "stiffness"),
+    (r"springs\.\d+\.rotational", "rotational_stiffness"),
     (r"supports\.(left|right)\.translational", "stiffness"),
     (r"supports\.(left|right)\.rotational", "rotational_stiffness"),
     (r"contactors\.\d+\.(position|gap)", "length"),

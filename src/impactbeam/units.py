@@ -63,6 +63,8 @@ DIMENSIONS: dict[str, _Dimension] = {
     "acceleration": _Dimension("m/s^2", "m/s^2", "an acceleration"),
     "force": _Dimension("N", "N", "a force"),
     "force_per_length": _Dimension("N/m", "N/m", "a force per length"),
+    "mass": _Dimension("kg", "kg", "a mass"),
+    "rotary_inertia": _Dimension("kg m^2", "kg*m^2", "a rotary inertia"),
     "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
 }
 

@@ -142,7 +142,9 @@ class StateSpace:
         n = ms.count
         Wc = np.ascontiguousarray(ms.shapes(self.positions).T) if self.contactors else np.zeros((0, n))
         Wo = np.ascontiguousarray(ms.shapes(self.points).T) if self.points.size else np.zeros((0, n))
-        p = spatial_projection(self.excitation, ms.shapes, ms.integral(), self.beam.mass_per_length)
+        p = spatial_projection(
+            self.excitation, ms.shapes, ms.integral(), self.beam.mass_per_length, inertia=ms.inertia_integral()
+        )
         gap_force = np.zeros(n)
         for i in engaged:
             c = self.contactors[i]
