@@ -142,3 +142,35 @@ def test_stale_temporary_files_of_killed_writers_are_removed(tmp_path):
     assert target.read_text() == "x = 1\n"
     assert not stale.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.toml"]
+
+
+def test_ten_million_case_sweep_starts_at_once_and_stops_on_ctrl_c(tmp_path):
+    # the store is created from metadata only and batches are generated lazily: the
+    # first cases are stored within seconds, not after building 10^7 cases up front
+    spec = tmp_path / "big.toml"
+    spec.write_text(
+        f'base = "{(EXAMPLES / "case03.toml").as_posix()}"\n'
+        '[parameters."contactors.0.gap"]\nrange = [0.0, 0.686e-3, 1000]\n'
+        '[parameters."excitation.duration"]\nrange = [5e-3, 20e-3, 100]\n'
+        '[parameters."excitation.amplitude"]\nrange = ["5 g", "20 g", 100]\n'
+    )
+    out = tmp_path / "big.zarr"
+    t_start = time.monotonic()
+    proc = subprocess.Popen([*CLI, "sweep", str(spec), "--out", str(out), "--workers", "0"], cwd=tmp_path,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    import zarr
+
+    started = None
+    while time.monotonic() - t_start < 120.0:
+        time.sleep(0.5)
+        try:
+            if (zarr.open_group(str(out), mode="r")["status"][0, 0, :] == 0).any():
+                started = time.monotonic() - t_start
+                break
+        except Exception:  # the store is being created
+            pass
+    assert started is not None and started < 60.0, started  # includes the process start and imports
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err[-2000:]
+    assert "Traceback" not in err
