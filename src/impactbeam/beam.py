@@ -1,6 +1,6 @@
 """The physical system: a uniform Euler-Bernoulli beam, its end supports and contactors.
 
-All quantities are SI. The sign convention (DESIGN.md section 1) is that the
+All quantities are SI. The sign convention (see the model page) is that the
 deflection ``w`` is measured from the undeformed rest position. A contactor
 ``below`` has its surface at ``w(a) = -gap`` and pushes with
 ``F = k (-gap - w(a))`` while ``w(a) < -gap``; one ``above`` is the mirror image.

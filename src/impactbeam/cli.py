@@ -206,7 +206,7 @@ def simulate(
 
     The metrics are those of w at the first contactor (or the first output
     point without contactors), as u positive away from the contactor
-    (DESIGN.md section 3).
+    (u = -w for a contactor above the beam, u = w below).
     """
     _check_output("--out", out, RESULT_SUFFIXES)
     _check_output("--plot", plot, PLOT_SUFFIXES)
@@ -217,9 +217,16 @@ def simulate(
     from .solver import simulate as run
 
     # import the writers before the (possibly long) run, so a broken install fails fast
+    from ._optional import require
+
     if out is not None:
         from .result import write_result
+
+        backend = {".nc": "h5netcdf", ".parquet": "pyarrow"}.get(Path(out).suffix.lower())
+        if backend:
+            require(backend, "io", feature=f"--out {Path(out).suffix.lower()}")
     if plot is not None:
+        require("matplotlib", "plot", feature="--plot")
         from .plot import plot_result
 
     result = run(sc)

@@ -706,5 +706,5 @@ def scenario_modes(scenario: Scenario, count: int | None = None) -> ScenarioMode
     return ScenarioModes(free, contact)
 
 
-#: ``ib.modes(scenario)`` (DESIGN.md section 6).
+#: ``ib.modes(scenario)`` (see the API reference).
 modes = scenario_modes

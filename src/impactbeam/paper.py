@@ -21,7 +21,7 @@ How the paper's numbers are read (stated in the report as well):
    measured from the contactor surface, positive away from it, so that a
    negative value means contact (section 3.1: "A deflection less than zero
    indicate that the structure enters into a contact state"). With the
-   project's convention (DESIGN.md section 1: ``w`` from rest; a contactor
+   project's convention (see the model page: ``w`` from rest; a contactor
    "above" has its surface at ``w(a) = +c``) that quantity is the gap
    function ``d = c - s w(a)`` (``s = +1`` above, ``-1`` below), i.e.
    ``d = u + c`` with ``u`` the metrics' deflection (positive away from the
@@ -1567,7 +1567,7 @@ def _document(rep: ReproductionReport, data: dict[str, Any]) -> _Doc:
           "contact point measured from the contactor surface, positive away from it, negative in contact (section 3.1: "
           "\"A deflection less than zero indicate that the structure enters into a contact state\"). With w from rest "
           "and the contactor above with gap c, that is the gap function `d = c - w(a)` = `u + c`, where `u = -w(a)` is "
-          "the project's metric deflection (positive away from the contactor, from rest; DESIGN.md section 3). "
+          "the project's metric deflection (positive away from the contactor, from rest). "
           "All deflections in this report are d, in mm. Without a contactor (Cases 1, 12) d = -w(0.4840 L), the same "
           "orientation; Cases 0 and 13 are shown as w at the tip.")
     doc.p("**Assumption about Table 2:** its maximum and minimum responses are also measured from the contactor "

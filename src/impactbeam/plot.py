@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from ._atomic import atomic_path
+from ._optional import require
 from .exceptions import ParameterError
 
 if TYPE_CHECKING:
@@ -75,7 +76,7 @@ class PlotHandles:
 
 def _new_figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
     """A figure on the Agg canvas, independent of pyplot's global state."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    FigureCanvasAgg = require("matplotlib.backends.backend_agg", "plot").FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=figsize, layout="constrained")
@@ -139,7 +140,7 @@ def surface_distance(
     """The paper's plotted deflection: distance from the contactor surface [m], positive away.
 
     With a contactor this is its gap function ``g = c - s w(a, t)`` (``s = +1``
-    for a contactor above, ``-1`` below; DESIGN.md section 1), i.e. ``u + c``
+    for a contactor above, ``-1`` below; see the model page), i.e. ``u + c``
     with ``u`` the metrics' deflection positive away from the contactor:
     negative values mean contact, as in Figs. 4-8 of Xu & Ervin (2013).
     Without a contactor it is ``-s w(x, t)`` at ``x`` (default the first

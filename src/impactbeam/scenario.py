@@ -1,4 +1,4 @@
-"""Scenario files: TOML <-> validated objects (DESIGN.md section 3).
+"""Scenario files: TOML <-> validated objects (see the scenario reference).
 
 A scenario describes one simulation: the beam and its supports, the
 contactors, damping, the excitation, the initial state, solver options and
@@ -755,7 +755,7 @@ def _parse_output(raw: Mapping[str, Any], beam: Beam, contactors: tuple[Contacto
 
 @dataclass(frozen=True, eq=False)
 class Scenario:
-    """A validated simulation case (DESIGN.md section 3).
+    """A validated simulation case (see the scenario reference).
 
     Attributes
     ----------
@@ -817,7 +817,7 @@ def parse_scenario(
     source: str | os.PathLike[str] | None = None,
     name: str = "scenario",
 ) -> Scenario:
-    """Validate a scenario mapping (the TOML schema of DESIGN.md section 3).
+    """Validate a scenario mapping (the TOML schema of the scenario reference).
 
     Parameters
     ----------

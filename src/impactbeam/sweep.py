@@ -1,6 +1,6 @@
 """Parameter studies: sweep files, execution on Dask, labelled results in Zarr that resume.
 
-A *sweep* varies a base scenario (DESIGN.md section 3) through dotted paths
+A *sweep* varies a base scenario (see the scenario reference) through dotted paths
 (``contactors.0.gap``, ``excitation.duration``, ``beam.height``, ...) and
 records, for every case, the scalar response metrics of
 :meth:`impactbeam.SimulationResult.metrics` (the quantities of the paper's
@@ -69,6 +69,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from ._optional import require
 from .exceptions import ImpactBeamError, ParameterError, ScenarioError, SimulationError
 from .metrics import METRIC_UNITS
 from .scenario import EXCITATION_DIMENSIONS, Scenario, load_scenario, parse_scenario
@@ -908,7 +909,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
 
 def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict[str, Any]]:
     """The empty result (every case not run) as a lazy Dataset, and its Zarr encoding."""
-    import dask.array as da
+    da = require("dask.array", "sweep")
     import xarray as xr
 
     from . import __version__
@@ -963,7 +964,7 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
         enc["w"] = {"chunks": hchunk, "fill_value": np.nan}
     c0 = spec.base.contactors[0] if spec.base.contactors else None
     where = (
-        "u at the first contactor, positive away from it (DESIGN.md section 3)"
+        "u at the first contactor, positive away from it (u = -w for a contactor above the beam)"
         if c0 is not None
         else "u = w at the first output point"
     )
@@ -987,7 +988,7 @@ def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> 
     """Write the empty store (metadata and coordinates); atomic for a directory."""
     ds, enc = _template(spec, chunk)
     if out is None:
-        import zarr
+        zarr = require("zarr", "sweep")
 
         store = zarr.storage.MemoryStore()
         ds.to_zarr(store, compute=False, encoding=enc, consolidated=False)
@@ -1008,7 +1009,7 @@ def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> 
 
 def _open_existing(spec: SweepSpec, out: Path) -> Any:
     """Open a store made by the same sweep, else raise ParameterError."""
-    import zarr
+    zarr = require("zarr", "sweep")
 
     try:
         group = zarr.open_group(str(out), mode="r")
@@ -1098,7 +1099,7 @@ class _Writer:
     """Writes finished batches into the store's chunks (status last)."""
 
     def __init__(self, store: Any, spec: SweepSpec) -> None:
-        import zarr
+        zarr = require("zarr", "sweep")
 
         self.group = zarr.open_group(store, mode="r+")
         self.arrays = {name: self.group[name] for name in (*spec.metrics, "message", "status")}
@@ -1133,6 +1134,8 @@ def run_sweep(
     on_error: Literal["record", "raise"] = "record",
 ) -> SweepRun:
     """Run (or resume) a sweep; like :func:`sweep` but returns a :class:`SweepRun` with counts."""
+    for name in ("zarr", "dask", "distributed"):  # before any work: one clear message
+        require(name, "sweep", feature="parameter sweeps")
     spec = _as_spec(spec_or_path)
     if on_error not in ("record", "raise"):
         raise ParameterError(f'on_error: must be "record" or "raise", got {on_error!r}')
@@ -1195,7 +1198,7 @@ def run_sweep(
     if out_path is not None:
         import warnings
 
-        import zarr
+        zarr = require("zarr", "sweep")
 
         # consolidated metadata lets xr.open_zarr(path) open the finished store without a
         # warning; zarr 3 notes (ZarrUserWarning) that it is an extension of its format 3
@@ -1221,7 +1224,7 @@ def _worker_config() -> dict[str, Any]:
       makes a simulation ~40 % slower.
     * No statistical profiler (it samples the computing thread every 10 ms).
     """
-    import dask
+    dask = require("dask", "sweep")
 
     env = dict(dask.config.get("distributed.nanny.pre-spawn-environ", {}) or {})
     env.pop("MALLOC_TRIM_THRESHOLD_", None)
@@ -1234,8 +1237,9 @@ def _run_dask(
     batches: list[_Batch], done: Any, *, workers: int | None, scheduler: str | None, on_error: str = "record"
 ) -> None:
     """Run the batches on a Dask cluster; ``done(region, result)`` as each finishes."""
-    import dask
-    from distributed import Client, LocalCluster, as_completed
+    dask = require("dask", "sweep")
+    distributed = require("distributed", "sweep")
+    Client, LocalCluster, as_completed = distributed.Client, distributed.LocalCluster, distributed.as_completed
 
     cluster = None
     client = None
@@ -1424,7 +1428,7 @@ def plot_sweep(
     matplotlib artist
         The Line2D, QuadMesh or PathCollection drawn.
     """
-    import matplotlib.pyplot as plt
+    plt = require("matplotlib.pyplot", "plot")
 
     if metric not in ds.data_vars or metric in ("status", "message", "w"):
         names = [v for v in ds.data_vars if v not in ("status", "message", "w")]
