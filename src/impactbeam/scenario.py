@@ -796,6 +796,12 @@ class Scenario:
         """The ``description`` string of the file, if any."""
         return self.data.get("description")
 
+    def _repr_html_(self) -> str:
+        """Compact summary table for Jupyter."""
+        from ._html import scenario_html
+
+        return scenario_html(self)
+
     def with_values(self, values: Mapping[str, Any]) -> Scenario:
         """A new scenario with the dotted paths in ``values`` set, re-validated.
 
