@@ -55,6 +55,19 @@ def test_model_matches_simulate_and_round_trips_toml(tmp_path: Path) -> None:
     assert again.contactors[0].gap == pytest.approx(0.300e-3, rel=1e-15) and again.solver.modes == 6
 
 
+def test_envelope_keeps_the_extremes() -> None:
+    import numpy as np
+
+    from impactbeam.explore import envelope
+
+    t = np.linspace(0.0, 1.0, 20001)
+    y = np.sin(2 * np.pi * 37 * t) * np.exp(-t) + (np.abs(t - 0.61803) < 2e-5) * 5.0  # a one-sample spike
+    tt, yy = envelope(t, y, bins=500)
+    assert tt.size <= 3 * 500 + 1 and np.all(np.diff(tt) > 0)
+    assert yy.max() == y.max() and yy.min() == y.min()  # the spike and the trough survive exactly
+    assert tt[0] == t[0] and tt[-1] == t[-1]
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -100,14 +113,19 @@ def test_explorer_in_headless_chromium(tmp_path: Path) -> None:
             gap_before = float(page.locator("#v-gap").inner_text())
             assert gap_before == pytest.approx(0.229, rel=1e-9)
 
-            page.locator(".ib-gap .noUi-handle").first.focus()
-            t0 = time.perf_counter()
-            page.keyboard.press("ArrowRight")  # one step: the latency of one change
-            while first.inner_text() == before:  # Playwright locators pierce the shadow DOM
-                assert time.perf_counter() - t0 < 30, "the first-impact time did not change"
-                time.sleep(0.005)
-            latency = time.perf_counter() - t0
-            for _ in range(19):  # 19 more steps of 0.001 mm
+            handle = page.locator(".ib-gap .noUi-handle").first
+            handle.focus()
+            latencies = []
+            for _ in range(5):  # one step of 0.001 mm at a time: the latency of one change
+                old = first.inner_text()
+                t0 = time.perf_counter()
+                page.keyboard.press("ArrowRight")
+                while first.inner_text() == old:  # Playwright locators pierce the shadow DOM
+                    assert time.perf_counter() - t0 < 30, "the first-impact time did not change"
+                    time.sleep(0.002)
+                latencies.append(time.perf_counter() - t0)
+            latency = sorted(latencies)[2]
+            for _ in range(15):  # 15 more steps at once
                 page.keyboard.press("ArrowRight")
             time.sleep(1.5)  # let the updates settle on the last value
             gap_mm = float(page.locator("#v-gap").inner_text())
@@ -121,7 +139,7 @@ def test_explorer_in_headless_chromium(tmp_path: Path) -> None:
             assert shown == pytest.approx(ref, abs=0.51e-7), (gap_mm, shown, ref)
             update_ms = float(page.locator("#m-update_ms").inner_text().split()[0])
             print(f"\nexplorer: gap {gap_before} -> {gap_mm} mm, first impact {before} -> {first.inner_text()}; "
-                  f"server update {update_ms:.1f} ms, key-press to redraw {latency * 1e3:.0f} ms")
+                  f"server update {update_ms:.1f} ms, key-press to redraw (median of 5) {latency * 1e3:.0f} ms, all {[round(x * 1e3) for x in latencies]}")
 
             with page.expect_download() as info:  # the save button
                 page.locator(".ib-save button").first.click()
