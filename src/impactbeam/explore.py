@@ -204,8 +204,6 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int = 1500) -> tuple[np.ndarray
         return t, y
     edges = np.linspace(0, n, bins + 1).astype(int)
     starts = edges[:-1]
-    lo = np.minimum.reduceat(y, starts)
-    hi = np.maximum.reduceat(y, starts)
     keep = [starts, starts + np.array([int(np.argmin(y[a:b])) for a, b in zip(edges[:-1], edges[1:])]),
             starts + np.array([int(np.argmax(y[a:b])) for a, b in zip(edges[:-1], edges[1:])])]
     idx = np.unique(np.concatenate(keep + [np.array([n - 1])]))

@@ -1,0 +1,100 @@
+"""Journal style of the figures of :mod:`impactbeam.plot`: sizes, fonts, series styles."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ._optional import require
+from .exceptions import ParameterError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["SERIES_STYLES", "STYLE", "WIDTHS", "figure_size"]
+
+_G = 9.80665
+
+#: Figure widths [in]: one and two journal columns.
+WIDTHS = {"single": 3.5, "double": 7.0}
+
+#: (colour, line style, marker) of successive series: Okabe-Ito colours and
+#: distinct dash patterns, distinguishable in grey-scale and by colour-blind readers.
+SERIES_STYLES: tuple[tuple[str, Any, str], ...] = (
+    ("#000000", "-", "o"),
+    ("#0072B2", "--", "s"),
+    ("#D55E00", ":", "^"),
+    ("#009E73", "-.", "D"),
+    ("#CC79A7", (0, (5, 1.5, 1, 1.5, 1, 1.5)), "v"),
+    ("#E69F00", (0, (8, 2)), "P"),
+    ("#56B4E9", (0, (1, 1)), "X"),
+)
+
+#: Matplotlib settings of every figure drawn here (fonts >= 8 pt at print size).
+STYLE = {
+    "font.size": 8,
+    "axes.labelsize": 8,
+    "axes.titlesize": 9,
+    "xtick.labelsize": 8,
+    "ytick.labelsize": 8,
+    "legend.fontsize": 8,
+    "lines.linewidth": 1.0,
+    "axes.linewidth": 0.6,
+    "grid.linewidth": 0.4,
+    "savefig.dpi": 300,
+}
+
+_EXCITATION_AXIS = {
+    "base_acceleration": ("base acceleration [g]", 1 / _G),
+    "point_force": ("force [N]", 1.0),
+    "distributed_force": ("distributed force [N/m]", 1.0),
+}
+
+
+def figure_size(size: str | tuple[float, float] = "double", aspect: float = 0.5) -> tuple[float, float]:
+    """Width and height [in] of a figure: ``"single"`` (3.5 in) or ``"double"`` column (7 in).
+
+    ``aspect`` is height / width; an explicit ``(width, height)`` passes through.
+    """
+    if isinstance(size, tuple):
+        return size
+    if size not in WIDTHS:
+        raise ParameterError(f'size: must be "single", "double" or (width, height) in inches, got {size!r}')
+    return WIDTHS[size], WIDTHS[size] * aspect
+
+
+def _style(i: int) -> dict[str, Any]:
+    color, ls, _ = SERIES_STYLES[i % len(SERIES_STYLES)]
+    return {"color": color, "ls": ls}
+
+
+def _styled(fn: Any) -> Any:
+    """Run a plotting function under :data:`STYLE` (an rc context, restored afterwards)."""
+    import functools
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        mpl = require("matplotlib", "plot")
+        with mpl.rc_context(STYLE):
+            return fn(*args, **kwargs)
+
+    return wrapper
+
+
+def _outside_legend(fig: Figure, ax: Axes, ncols: int = 3) -> Any:
+    """A legend below the axes grid (never over the data); None when nothing is labelled."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    return fig.legend(handles, labels, loc="outside lower center", ncols=min(ncols, len(handles)), frameon=False)
+
+
+def _log_ticks(axis: Any) -> None:
+    """Label a log axis at 1, 2, 5 times the decades only, in plain numbers (no overlap)."""
+    ticker = require("matplotlib.ticker", "plot")
+    axis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0), numticks=12))
+    axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_locator(ticker.LogLocator(base=10, subs=np.arange(1, 10) * 1.0, numticks=12))
+    axis.set_minor_formatter(ticker.NullFormatter())
