@@ -150,3 +150,20 @@ def test_save_figure_rejects_unknown_suffix(case3, tmp_path):
 def test_result_plot_forwards(case3, tmp_path):
     h = case3.plot(tmp_path / "f.png")
     assert isinstance(h, plot.PlotHandles) and (tmp_path / "f.png").is_file()
+
+
+@pytest.mark.parametrize(
+    ("name", "units", "label", "scale"),
+    [
+        ("contactors.0.gap", "m", "gap [mm]", 1e3),
+        ("contactors.1.stiffness", "N/m", "stiffness (contactor 1) [N/m]", 1.0),
+        ("excitation.duration", "s", "pulse duration [ms]", 1e3),
+        ("max_response", "m", "max response [mm]", 1e3),
+        ("n_impacts", "1", "n impacts", 1.0),
+        ("damping.free", None, "damping ratio, free state", 1.0),
+    ],
+)
+def test_sweep_axis_labels_are_readable(name, units, label, scale):
+    from impactbeam._plotstyle import display_label
+
+    assert display_label(name, units) == (label, scale)

@@ -98,3 +98,23 @@ def _log_ticks(axis: Any) -> None:
     axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     axis.set_minor_locator(ticker.LogLocator(base=10, subs=np.arange(1, 10) * 1.0, numticks=12))
     axis.set_minor_formatter(ticker.NullFormatter())
+
+
+#: SI unit -> (display unit, factor) for axes: lengths in mm and times in ms, as the summaries.
+DISPLAY_UNITS = {"m": ("mm", 1e3), "s": ("ms", 1e3)}
+
+
+def display_label(name: str, units: str | None) -> tuple[str, float]:
+    """Axis label and scale factor of a labelled quantity, e.g. ``"contactors.0.gap", "m"`` ->
+    ``("gap [mm]", 1000.0)``; the first contactor's index is dropped, others are kept.
+    """
+    parts = name.split(".")
+    short = parts[-1].replace("_", " ")
+    if len(parts) == 3 and parts[0] == "contactors" and parts[1] != "0":
+        short += f" (contactor {parts[1]})"
+    elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("duration", "amplitude", "scale", "start"):
+        short = f"pulse {short}"
+    elif len(parts) == 2 and parts[0] == "damping":
+        short = f"damping ratio, {parts[1]} state"
+    unit, scale = DISPLAY_UNITS.get(units or "", (units, 1.0))
+    return (f"{short} [{unit}]" if unit not in (None, "", "1") else short), scale

@@ -1363,8 +1363,14 @@ def sweep(
 
 
 def _axis_label(ds: Any, name: str) -> str:
-    units = ds[name].attrs.get("units")
-    return f"{name} [{units}]" if units not in (None, "", "1") else name
+    return _axis(ds, name)[0]
+
+
+def _axis(ds: Any, name: str) -> tuple[str, float]:
+    """Display label ("gap [mm]") and the factor from the stored SI values."""
+    from ._plotstyle import display_label
+
+    return display_label(name, ds[name].attrs.get("units"))
 
 
 def select_cases(ds: Any, keep: Sequence[str], sel: Mapping[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
@@ -1441,15 +1447,17 @@ def plot_sweep(
         raise ParameterError("--y: must differ from --x")
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 4.4))
-    label = _axis_label(ds, metric)
+    label, fm = _axis(ds, metric)
+    fx = _axis(ds, x)[1]
+    fy = _axis(ds, y)[1] if y is not None else 1.0
     if "case" in ds.dims:
-        xs = ds[x].values
-        vals = ds[metric].values
+        xs = ds[x].values * fx
+        vals = ds[metric].values * fm
         if y is None:
             handle = ax.scatter(xs, vals, s=10)
             ax.set_ylabel(label)
         else:
-            handle = ax.scatter(xs, ds[y].values, c=vals, s=14, cmap="viridis")
+            handle = ax.scatter(xs, ds[y].values * fy, c=vals, s=14, cmap="viridis")
             ax.figure.colorbar(handle, ax=ax, label=label)
             ax.set_ylabel(_axis_label(ds, y))
         ax.set_xlabel(_axis_label(ds, x))
@@ -1459,14 +1467,15 @@ def plot_sweep(
     da = sub[metric].load()
     numeric_x = da[x].dtype.kind in "fiu"
     if y is None:
-        xs = da[x].values if numeric_x else np.arange(da.sizes[x])
-        (handle,) = ax.plot(xs, da.values, marker="o", ms=3)
+        xs = da[x].values * fx if numeric_x else np.arange(da.sizes[x])
+        (handle,) = ax.plot(xs, da.values * fm, marker="o", ms=3)
         if not numeric_x:
             ax.set_xticks(xs, [str(v) for v in da[x].values])
         ax.set_ylabel(label)
     else:
         da = da.transpose(y, x)
-        handle = ax.pcolormesh(_edges(da[x].values), _edges(da[y].values), da.values, shading="flat", cmap="viridis")
+        handle = ax.pcolormesh(_edges(da[x].values * fx), _edges(da[y].values * fy), da.values * fm, shading="flat",
+                               cmap="viridis")
         ax.figure.colorbar(handle, ax=ax, label=label)
         ax.set_ylabel(_axis_label(ds, y))
     ax.set_xlabel(_axis_label(ds, x))
