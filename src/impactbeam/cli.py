@@ -240,7 +240,7 @@ def simulate(
             _fail(f'--out: cannot write "{out}": {exc}', 1)
     if plot is not None:
         try:
-            plot_result(result, plot)
+            plot_result(result, plot, excitation=sc.excitation)
         except OSError as exc:
             _fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:
