@@ -40,6 +40,7 @@ def _run_cli(args: list[str], blocked: tuple[str, ...], tmp_path: Path) -> subpr
         (["simulate", str(EXAMPLES / "case03.toml"), "--out", "r.nc"], ("h5netcdf",), "io"),
         (["simulate", str(EXAMPLES / "case03.toml"), "--out", "r.parquet"], ("pyarrow",), "io"),
         (["simulate", str(EXAMPLES / "case03.toml"), "--plot", "r.png"], ("matplotlib",), "plot"),
+        (["explore", str(EXAMPLES / "case03.toml"), "--port", "0"], ("panel",), "explore"),
     ],
 )
 def test_missing_extra_is_named(args: list[str], blocked: tuple[str, ...], extra: str, tmp_path: Path) -> None:
