@@ -88,7 +88,25 @@ def _outside_legend(fig: Figure, ax: Axes, ncols: int = 3) -> Any:
     handles, labels = ax.get_legend_handles_labels()
     if not handles:
         return None
-    return fig.legend(handles, labels, loc="outside lower center", ncols=min(ncols, len(handles)), frameon=False)
+    # about 14 characters of 8 pt text per inch, plus the line sample: columns that fit the width
+    fit = int(fig.get_figwidth() * 14 // (max(len(str(lab)) for lab in labels) + 7))
+    ncols = max(1, min(ncols, len(handles), fit))
+    return fig.legend(handles, labels, loc="outside lower center", ncols=ncols, frameon=False)
+
+
+def _side_legend(ax: Axes) -> Any:
+    """A legend to the right of given axes (outside the data); None when nothing is labelled."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, frameon=False)
+
+
+def _wrap(label: str, width: int = 38) -> str:
+    """Break a long axis label into lines so that it fits a narrow panel."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(label, width)) if len(label) > width else label
 
 
 def _log_ticks(axis: Any) -> None:
@@ -118,3 +136,18 @@ def display_label(name: str, units: str | None) -> tuple[str, float]:
         short = f"damping ratio, {parts[1]} state"
     unit, scale = DISPLAY_UNITS.get(units or "", (units, 1.0))
     return (f"{short} [{unit}]" if unit not in (None, "", "1") else short), scale
+
+
+def rc_context() -> Any:
+    """The rc context of :data:`STYLE`, for figures assembled from several calls."""
+    return require("matplotlib", "plot").rc_context(STYLE)
+
+
+def _response_label(runs: list[Any], quantity: str, side: str) -> str:
+    if quantity == "w":
+        return "deflection w [mm]"
+    if all(len(r.contactors) for r in runs):
+        return "distance from contactor surface d [mm]\n(positive away; < 0: in contact)"
+    if not any(len(r.contactors) for r in runs):
+        return f"deflection {'-w' if side == 'above' else 'w'} [mm]"
+    return "d (runs with contactor), u (without) [mm]"

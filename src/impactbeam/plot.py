@@ -40,6 +40,10 @@ from ._plotstyle import (
     STYLE,
     _log_ticks,
     _outside_legend,
+    _response_label,
+    rc_context,
+    _side_legend,
+    _wrap,
     _style,
     _styled,
     figure_size,
@@ -111,11 +115,6 @@ class PlotHandles:
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def rc_context() -> Any:
-    """The rc context of :data:`STYLE`, for figures assembled from several calls."""
-    return require("matplotlib", "plot").rc_context(STYLE)
 
 
 def _new_figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
@@ -336,23 +335,13 @@ def plot_result(
         (ax_ex or ax_w).set_title(heading)
         fig.align_ylabels()
     else:
-        artists["legend"] = ax_w.legend(loc="best")
+        artists["legend"] = _side_legend(ax_w)
         ax_w.set_title(heading)
     axes = tuple(a for a in (ax_w, ax_f, ax_ex) if a is not None)
     return _finish(PlotHandles(fig, axes, tuple(lines), artists), path, dpi)
 
 
 # --------------------------------------------------------------------------- groups of histories
-
-
-def _response_label(runs: list[Any], quantity: str, side: str) -> str:
-    if quantity == "w":
-        return "deflection w [mm]"
-    if all(len(r.contactors) for r in runs):
-        return "distance from contactor surface d [mm]\n(positive away; < 0: in contact)"
-    if not any(len(r.contactors) for r in runs):
-        return f"deflection {'-w' if side == 'above' else 'w'} [mm]"
-    return "d (runs with contactor), u (without) [mm]"
 
 
 @_styled
@@ -433,7 +422,7 @@ def plot_response(
     ax.grid(True, alpha=0.3)
     if title:
         ax.set_title(title)
-    artists["legend"] = _outside_legend(fig, ax, ncols=3 if size == "double" else 1) if own else ax.legend(loc="best")
+    artists["legend"] = _outside_legend(fig, ax, ncols=3 if size == "double" else 1) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), artists), path, dpi)
 
 
@@ -477,7 +466,7 @@ def plot_excitation(
     ax.set_xlabel("time t [ms]")
     ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
-    leg = _outside_legend(fig, ax) if own else ax.legend(loc="best")
+    leg = _outside_legend(fig, ax) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
 
 
@@ -551,9 +540,11 @@ def plot_parameter_study(
         if baseline is not None:
             a.axvline(baseline, color="0.45", ls=":", lw=0.9)
         a.set_xscale(xscale)
+        if ok.any() and np.all(y[ok] == np.round(y[ok])):  # counts: integer ticks
+            a.yaxis.set_major_locator(require("matplotlib.ticker", "plot").MaxNLocator(integer=True))
         if xscale == "log":
             _log_ticks(a.xaxis)
-        a.set_xlabel(parameter_label)
+        a.set_xlabel(_wrap(parameter_label) if len(axes) > 1 else parameter_label)
         a.set_ylabel(labels.get(name, name))
         a.grid(True, alpha=0.3)
     if title:
@@ -604,5 +595,5 @@ def plot_convergence(
     ax.grid(True, which="both", alpha=0.3)
     if title:
         ax.set_title(title)
-    leg = _outside_legend(fig, ax, ncols=1) if own else ax.legend(loc="best")
+    leg = _outside_legend(fig, ax, ncols=1) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
