@@ -202,11 +202,14 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int = 1500) -> tuple[np.ndarray
     n = t.size
     if n <= 3 * bins:
         return t, y
-    edges = np.linspace(0, n, bins + 1).astype(int)
-    starts = edges[:-1]
-    keep = [starts, starts + np.array([int(np.argmin(y[a:b])) for a, b in zip(edges[:-1], edges[1:])]),
-            starts + np.array([int(np.argmax(y[a:b])) for a, b in zip(edges[:-1], edges[1:])])]
-    idx = np.unique(np.concatenate(keep + [np.array([n - 1])]))
+    k = n // bins  # samples per bucket; the last bucket takes the remainder
+    body = y[: k * bins].reshape(bins, k)
+    starts = np.arange(bins) * k
+    tail = np.arange(k * bins, n)
+    keep = [starts, starts + body.argmin(axis=1), starts + body.argmax(axis=1), tail[:1], [n - 1]]
+    if tail.size:
+        keep += [[tail[np.argmin(y[tail])]], [tail[np.argmax(y[tail])]]]
+    idx = np.unique(np.concatenate([np.asarray(i, dtype=int) for i in keep]))
     return t[idx], y[idx]
 
 
