@@ -9,6 +9,5 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import matplotlib  # noqa: E402
-
-matplotlib.use("Agg")
+# Figures render off-screen; the library itself never chooses a backend.
+os.environ.setdefault("MPLBACKEND", "Agg")

@@ -21,21 +21,58 @@ def case12():
 
 def test_plot_result_draws_the_solution(case3, tmp_path):
     path = tmp_path / "r.png"
-    h = plot.plot_result(case3, path)
-    ax_w, ax_f = h.axes
+    h = plot.plot_result(case3, path, excitation=paper.case(3).excitation)
+    ax_w, ax_f, ax_ex = h.axes
     x, y = h.lines[0].get_data()
-    np.testing.assert_array_equal(x, case3.time)
-    np.testing.assert_allclose(y, case3.w_contact[:, 0] * 1e3)  # mm
-    assert "[mm]" in ax_w.get_ylabel() and "[N]" in ax_f.get_ylabel() and "[s]" in ax_f.get_xlabel()
+    np.testing.assert_allclose(x, case3.time * 1e3)  # ms, as the metric summaries
+    # u, the metrics' quantity: -w for the contactor above, in mm
+    np.testing.assert_allclose(y, -case3.w_contact[:, 0] * 1e3)
+    assert y.max() == pytest.approx(case3.metrics()["max_response"] * 1e3, rel=3e-6)  # sampled vs exact peak
+    assert "[mm]" in ax_w.get_ylabel() and "[N]" in ax_f.get_ylabel() and "[ms]" in ax_f.get_xlabel()
+    assert "[g]" in ax_ex.get_ylabel() and h.artists["excitation"].get_ydata().max() == pytest.approx(15.0, rel=1e-3)
+    legend = h.artists["legend"]  # below the axes, never over the data
+    fig = h.figure
+    fig.canvas.draw()
+    box = legend.get_window_extent()
+    assert all(box.y1 <= a.get_window_extent().y0 + 1 for a in h.axes)
+    assert fig.get_figwidth() == pytest.approx(7.0)  # two journal columns
     n_impacts = sum(e.kind == "impact" for e in case3.events)
     assert len(h.artists["contact_spans"]) == n_impacts > 0
     assert len(h.artists["impacts"].get_xdata()) == n_impacts
-    assert h.artists["surface"].get_ydata()[0] == pytest.approx(0.229)
+    assert h.artists["surface"].get_ydata()[0] == pytest.approx(-0.229)  # u = -gap at the surface
     import matplotlib.image as mpimg
 
     img = mpimg.imread(path)
     assert img.shape[0] > 100 and np.std(img[..., :3]) > 0.01
     assert not list(tmp_path.glob(".*"))  # no temporary file left
+
+
+def test_plot_result_single_column_both_quantities_vector(case3, tmp_path):
+    h = plot.plot_result(case3, tmp_path / "r.svg", size="single", quantity="both")
+    assert h.figure.get_figwidth() == pytest.approx(3.5)
+    (u, w) = (line.get_ydata() for line in h.lines[:2])
+    np.testing.assert_allclose(u, -w)  # contactor above: u = -w
+    assert {line.get_label() for line in h.lines[:2]} == {"u", "w (from rest)"}
+    text = (tmp_path / "r.svg").read_text()
+    assert text.lstrip().startswith("<?xml") and "<svg" in text
+    h.save(tmp_path / "r.pdf")
+    assert (tmp_path / "r.pdf").read_bytes()[:5] == b"%PDF-"
+    fonts = [t.get_fontsize() for a in h.axes for t in [a.xaxis.label, a.yaxis.label, *a.get_xticklabels()]]
+    assert min(fonts) >= 8  # journal minimum at print size
+    with pytest.raises(ib.ParameterError, match="size"):
+        plot.plot_result(case3, size="quarter")
+
+
+def test_plot_handles_display_as_figure_in_jupyter(case3):
+    h = plot.plot_response(case3)
+    bundle = h._repr_mimebundle_()
+    assert bundle["image/png"][:8] == b"\x89PNG\r\n\x1a\n"
+    assert len(repr(h)) < 100 and "array" not in repr(h)
+
+
+def test_series_styles_differ_without_colour():
+    styles = [ls for _, ls, _ in plot.SERIES_STYLES]
+    assert len({str(s) for s in styles}) == len(styles)  # distinct dash patterns: grey-scale safe
 
 
 def test_plot_result_on_given_axes(case3):
@@ -48,6 +85,8 @@ def test_plot_result_on_given_axes(case3):
 def test_plot_result_without_contactor(case12):
     h = plot.plot_result(case12)
     assert len(h.axes) == 1 and h.artists["contact_spans"] == []
+    h = plot.plot_response(case12)  # no contactor: no "contactor surface" in the label
+    assert "contactor" not in h.axes[0].get_ylabel() and "[mm]" in h.axes[0].get_ylabel()
 
 
 def test_surface_distance_is_gap_function(case3, case12):
@@ -70,7 +109,8 @@ def test_plot_response_dense_point(case12):
 def test_plot_response_reference_and_errors(case3):
     h = plot.plot_response([case3, case3], labels=["a", "b"], reference=[(1.0e-3, "ref")], time_window=(0.0, 0.02))
     assert len(h.lines) == 2 and h.artists["reference"][0].get_ydata()[0] == pytest.approx(1.0)
-    assert h.lines[0].get_data()[0].max() <= 0.02
+    assert h.lines[0].get_data()[0].max() <= 20.0  # ms
+    assert h.lines[0].get_linestyle() != h.lines[1].get_linestyle()
     with pytest.raises(ib.ParameterError, match="labels"):
         plot.plot_response([case3], labels=["a", "b"])
     with pytest.raises(ib.ParameterError, match="quantity"):
@@ -82,7 +122,8 @@ def test_plot_excitation_in_g():
     h = plot.plot_excitation([ex], labels=["15 g"])
     t, y = h.lines[0].get_data()
     assert y.max() == pytest.approx(15.0, rel=1e-3)  # half-sine peak in g, sampled at 50 us
-    assert "[g]" in h.axes[0].get_ylabel()
+    assert "[g]" in h.axes[0].get_ylabel() and "[ms]" in h.axes[0].get_xlabel()
+    assert t.max() == pytest.approx(30.0)  # 0.03 s in ms
 
 
 def test_plot_parameter_study_and_convergence(tmp_path):
@@ -109,3 +150,20 @@ def test_save_figure_rejects_unknown_suffix(case3, tmp_path):
 def test_result_plot_forwards(case3, tmp_path):
     h = case3.plot(tmp_path / "f.png")
     assert isinstance(h, plot.PlotHandles) and (tmp_path / "f.png").is_file()
+
+
+@pytest.mark.parametrize(
+    ("name", "units", "label", "scale"),
+    [
+        ("contactors.0.gap", "m", "gap [mm]", 1e3),
+        ("contactors.1.stiffness", "N/m", "stiffness (contactor 1) [N/m]", 1.0),
+        ("excitation.duration", "s", "pulse duration [ms]", 1e3),
+        ("max_response", "m", "max response [mm]", 1e3),
+        ("n_impacts", "1", "n impacts", 1.0),
+        ("damping.free", None, "damping ratio, free state", 1.0),
+    ],
+)
+def test_sweep_axis_labels_are_readable(name, units, label, scale):
+    from impactbeam._plotstyle import display_label
+
+    assert display_label(name, units) == (label, scale)

@@ -358,10 +358,12 @@ def test_plot_line_and_heat_map(grid_run, tmp_path):
 
     fig, ax = plt.subplots()
     line = plot_sweep(run.dataset, "excitation.duration", "first_impact_time", sel={"contactors.0.gap": 0.229e-3}, ax=ax)
-    np.testing.assert_array_equal(
-        line.get_ydata(), run.dataset["first_impact_time"].sel({"contactors.0.gap": 0.229e-3}).values[:, 0]
+    np.testing.assert_allclose(  # shown in ms, as the summaries
+        line.get_ydata(), run.dataset["first_impact_time"].sel({"contactors.0.gap": 0.229e-3}).values[:, 0] * 1e3,
+        rtol=1e-15,
     )
-    assert ax.get_ylabel() == "first_impact_time [s]" and ax.get_xlabel() == "excitation.duration [s]"
+    np.testing.assert_allclose(line.get_xdata(), run.dataset["excitation.duration"].values * 1e3, rtol=1e-15)
+    assert ax.get_ylabel() == "first impact time [ms]" and ax.get_xlabel() == "pulse duration [ms]"
     plt.close(fig)
 
 

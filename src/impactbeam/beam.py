@@ -6,7 +6,7 @@ also be piecewise uniform (:class:`Section`), carry point masses
 (:class:`InteriorSpring`). These change only the segments and joint
 conditions of the exact modal analysis (:mod:`impactbeam.modes`).
 
-All quantities are SI. The sign convention (DESIGN.md section 1) is that the
+All quantities are SI. The sign convention (see the model page) is that the
 deflection ``w`` is measured from the undeformed rest position. A contactor
 ``below`` has its surface at ``w(a) = -gap`` and pushes with
 ``F = k (-gap - w(a))`` while ``w(a) < -gap``; one ``above`` is the mirror image.

@@ -327,7 +327,7 @@ def simulate(
 
     The metrics are those of w at the first contactor (or the first output
     point without contactors), as u positive away from the contactor
-    (DESIGN.md section 3).
+    (u = -w for a contactor above the beam, u = w below).
     """
     _check_output("--out", out, RESULT_SUFFIXES)
     _check_output("--plot", plot, PLOT_SUFFIXES)
@@ -341,13 +341,19 @@ def simulate(
     from .solver import simulate as run
 
     # import the writers before the (possibly long) run, so a broken install fails fast
+    from ._optional import require
+
     if out is not None:
         from .result import check_output_size, write_result
 
+        backend = {".nc": "h5netcdf", ".parquet": "pyarrow"}.get(Path(out).suffix.lower())
+        if backend:
+            require(backend, "io", feature=f"--out {Path(out).suffix.lower()}")
         n_t = int(math.floor(sc.solver.end_time / sc.solver.time_step * (1.0 + 1e-12))) + 1
         n_m = 200 if sc.solver.modes == "auto" else int(sc.solver.modes)
         check_output_size(n_t, len(sc.output_points), len(sc.contactors), n_m)  # before any work
     if plot is not None:
+        require("matplotlib", "plot", feature="--plot")
         from .plot import plot_result
 
     with _progress(sc.solver.end_time) as report:
@@ -364,7 +370,7 @@ def simulate(
             _fail(f'--out: cannot write "{out}": {exc}', 1)
     if plot is not None:
         try:
-            plot_result(result, plot)
+            plot_result(result, plot, excitation=sc.excitation)
         except OSError as exc:
             _fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:

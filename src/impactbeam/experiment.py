@@ -19,7 +19,7 @@ A :class:`Record` is one channel against time, in SI units: a deflection
 [m] or a base acceleration [m/s^2]. :func:`load_record` reads CSV and netCDF.
 
 Sign convention: a deflection record holds ``w`` at one point of the beam in
-the model's convention (DESIGN.md section 1: measured from the rest position,
+the model's convention (see the model page: measured from the rest position,
 positive along +w). The comparison quantities are computed, as the metrics
 of :mod:`impactbeam.metrics`, on ``u`` positive away from the first
 contactor (``u = -w`` for a contactor "above"), so a contact shows as ``u``
@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from ._optional import require
 from ._textdata import numeric_columns, read_delimited
 from .exceptions import ParameterError, ScenarioError, SimulationError
 
@@ -194,7 +195,7 @@ class Record:
 
     def plot(self, *, ax: Any = None, scale: float | None = None, **kwargs: Any) -> Any:
         """Plot the record against time; returns the line. ``scale`` defaults to mm for deflections."""
-        import matplotlib.pyplot as plt
+        plt = require("matplotlib.pyplot", "plot")
 
         if ax is None:
             _, ax = plt.subplots()
@@ -1358,11 +1359,8 @@ class Comparison:
         Returns the ``(figure, axes, lines)`` of matplotlib; with ``path`` the
         figure is also saved (atomically) there.
         """
-        import matplotlib
-
         if ax is None:
-            matplotlib.use("Agg", force=False)
-            import matplotlib.pyplot as plt
+            plt = require("matplotlib.pyplot", "plot")
 
             fig, ax = plt.subplots(figsize=(8, 4.5))
         else:

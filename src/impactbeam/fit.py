@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from ._atomic import write_text
+from ._optional import require
 from .exceptions import ParameterError, ScenarioError, SimulationError
 from .experiment import Record, _prepare, record_point
 
@@ -394,7 +395,7 @@ def fit(
     SimulationError
         When a simulation fails during the fit.
     """
-    import lmfit
+    lmfit = require("lmfit", "fit")
 
     from .loading import Excitation
     from .solver import simulate

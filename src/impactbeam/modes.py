@@ -115,6 +115,12 @@ class ModeSet:
     _rigid: np.ndarray = field(repr=False)  # (n_rigid, 2)
     _kry: np.ndarray = field(repr=False)  # (n, s) True where a segment uses the Krylov basis
 
+    def _repr_html_(self) -> str:
+        """Compact summary table for Jupyter: the state's springs and first frequencies."""
+        from ._html import modeset_html
+
+        return modeset_html(self)
+
     @property
     def count(self) -> int:
         """Number of modes in the set."""
@@ -385,6 +391,16 @@ class ScenarioModes:
     free: ModeSet
     contact: ModeSet | None
 
+    def _repr_html_(self) -> str:
+        """Both states side by side for Jupyter."""
+        from ._html import modeset_html
+
+        parts = [modeset_html(self.free).replace("ModeSet", "Free state", 1)]
+        if self.contact is not None:
+            parts.append(modeset_html(self.contact).replace("ModeSet", "Contact state", 1))
+        cells = "".join(f'<div style="margin-right:2em">{p}</div>' for p in parts)
+        return f'<div style="display:flex;flex-wrap:wrap">{cells}</div>'
+
 
 def scenario_modes(scenario: Scenario, count: int | None = None) -> ScenarioModes:
     """Free-state and all-engaged contact-state modes of a scenario.
@@ -403,5 +419,5 @@ def scenario_modes(scenario: Scenario, count: int | None = None) -> ScenarioMode
     return ScenarioModes(free, contact)
 
 
-#: ``ib.modes(scenario)`` (DESIGN.md section 6).
+#: ``ib.modes(scenario)`` (see the API reference).
 modes = scenario_modes

@@ -21,7 +21,7 @@ How the paper's numbers are read (stated in the report as well):
    measured from the contactor surface, positive away from it, so that a
    negative value means contact (section 3.1: "A deflection less than zero
    indicate that the structure enters into a contact state"). With the
-   project's convention (DESIGN.md section 1: ``w`` from rest; a contactor
+   project's convention (see the model page: ``w`` from rest; a contactor
    "above" has its surface at ``w(a) = +c``) that quantity is the gap
    function ``d = c - s w(a)`` (``s = +1`` above, ``-1`` below), i.e.
    ``d = u + c`` with ``u`` the metrics' deflection (positive away from the
@@ -1110,13 +1110,16 @@ def _figures(data: dict[str, Any], fig_dir: Path, tick: Callable[[str], None]) -
 
     def save(name: str, handles: Any) -> None:
         path = fig_dir / f"{name}.png"
-        P.save_figure(getattr(handles, "figure", handles), path)
+        fig = getattr(handles, "figure", handles)
+        P.save_figure(fig, path, dpi=200)
+        P.save_figure(fig, path.with_suffix(".pdf"))  # vector copy for papers
         figs[name] = path
         tick(f"figure {name}")
 
     window = (0.0, 0.2)
     # Fig. 4: pulse duration
-    fig, grid = P._new_figure((8.0, 6.4), 2, 1, height_ratios=[1.0, 2.0])
+    with P.rc_context():
+        fig, grid = P._new_figure((7.0, 5.2), 2, 1, height_ratios=[1.0, 2.0])
     group = (3, 4, 5)
     P.plot_excitation([scs[n].excitation for n in group], ax=grid[0, 0], end_time=0.03,
                       labels=[f"Case {n}: {TABLE1[n].label}" for n in group])
@@ -1153,19 +1156,22 @@ def _figures(data: dict[str, Any], fig_dir: Path, tick: Callable[[str], None]) -
     save("fig8_case3", h)
     # Case 3 detail with contact force
     h = P.plot_result(res[3], title="Case 3: w at the contact point, contact intervals and force")
-    h.axes[0].set_xlim(0.0, 0.08)
+    h.axes[0].set_xlim(0.0, 80.0)  # ms
     save("case3_detail", h)
     # Case 0 free decay
     h = P.plot_response([res[0]], quantity="w", x=scs[0].beam.length, labels=["Case 0: tip"],
                         title="Case 0: free decay after release from a 2 mm tip deflection")
     P.plot_response([res[0]], quantity="w", x=SPECIMEN["contact_position_ratio"] * scs[0].beam.length,
                     ax=h.axes[0], labels=["Case 0: contact point 0.4840 L"])
-    h.axes[0].get_lines()[-1].set_color("C1")
-    h.axes[0].legend(loc="upper right", fontsize=8)
+    h.axes[0].get_lines()[-1].set(color="#0072B2", ls="--")
+    for leg in list(h.figure.legends):
+        leg.remove()
+    P._outside_legend(h.figure, h.axes[0])
     save("case0_free_decay", h)
     # convergence
     conv = data["convergence"]
-    fig, grid = P._new_figure((9.0, 3.8), 1, 2)
+    with P.rc_context():
+        fig, grid = P._new_figure((7.0, 3.4), 1, 2)
     P.plot_convergence(CONVERGENCE_MODES, {
         "Case 12 first peak": [conv[12][m].max_response for m in CONVERGENCE_MODES],
         "Case 12 first negative peak": [conv[12][m].min_response for m in CONVERGENCE_MODES],
@@ -1194,9 +1200,10 @@ def _figures(data: dict[str, Any], fig_dir: Path, tick: Callable[[str], None]) -
             title=f"One-at-a-time study around Case 3: {spec['label']}")
         reb = [m.rebound_response * 1e3 for _, m in rows]
         ok = np.isfinite(reb)
-        h.axes[0].plot(np.asarray(xs)[ok], np.asarray(reb)[ok], marker="s", ms=3, ls="--", color="C1",
+        h.axes[0].lines[0].set_label("max response")
+        h.axes[0].plot(np.asarray(xs)[ok], np.asarray(reb)[ok], marker="s", ms=3, ls="--", color="#0072B2",
                        label="rebound response")
-        h.axes[0].legend(fontsize=7)
+        P._outside_legend(h.figure, h.axes[0])
         save(f"study_{name}", h)
     return figs
 
@@ -1567,7 +1574,7 @@ def _document(rep: ReproductionReport, data: dict[str, Any]) -> _Doc:
           "contact point measured from the contactor surface, positive away from it, negative in contact (section 3.1: "
           "\"A deflection less than zero indicate that the structure enters into a contact state\"). With w from rest "
           "and the contactor above with gap c, that is the gap function `d = c - w(a)` = `u + c`, where `u = -w(a)` is "
-          "the project's metric deflection (positive away from the contactor, from rest; DESIGN.md section 3). "
+          "the project's metric deflection (positive away from the contactor, from rest). "
           "All deflections in this report are d, in mm. Without a contactor (Cases 1, 12) d = -w(0.4840 L), the same "
           "orientation; Cases 0 and 13 are shown as w at the tip.")
     doc.p("**Assumption about Table 2:** its maximum and minimum responses are also measured from the contactor "

@@ -1,14 +1,24 @@
-"""Matplotlib figures of simulation results (optional layer, Agg backend).
+"""Matplotlib figures of simulation results, sized and styled for journals.
 
 Every function takes an optional ``ax=`` (or ``axes=``), never touches the
 global pyplot state when it creates its own figure (a bare
-:class:`matplotlib.figure.Figure` on the Agg canvas), labels its axes with
-units and returns a :class:`PlotHandles`. Functions given ``path`` write the
-figure atomically (a temporary file in the same directory, then
-:func:`os.replace`), so an interrupted run never leaves half an image.
+:class:`matplotlib.figure.Figure` on the Agg canvas, whatever the user's
+backend), labels its axes with units and returns a :class:`PlotHandles`,
+which Jupyter displays as the figure. Functions given ``path`` write the
+figure atomically; the format follows the suffix (``.png``, ``.pdf``,
+``.svg`` ...).
 
-Deflections are plotted in millimetres and times in seconds, as in the
-figures of Xu & Ervin (2013).
+Conventions, for figures that go into a paper:
+
+* widths of one journal column (``size="single"``, 3.5 in) or two
+  (``"double"``, 7 in), fonts of 8 pt (9 pt titles) at print size;
+* time in ms and deflections in mm, as in the metrics summaries;
+* the response as ``u``, the quantity of the metrics (``u = -w`` for a
+  contactor above the beam, ``w`` below: positive away from the contactor),
+  or ``w`` or both, always labelled;
+* series that differ in line style as well as colour (the Okabe-Ito
+  palette), so they survive grey-scale printing and colour-blindness;
+* legends outside the data area of figures drawn here.
 """
 
 from __future__ import annotations
@@ -23,6 +33,21 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from ._atomic import atomic_path
+from ._optional import require
+from ._plotstyle import (
+    _EXCITATION_AXIS,
+    SERIES_STYLES,
+    STYLE,
+    _log_ticks,
+    _outside_legend,
+    _response_label,
+    rc_context,
+    _side_legend,
+    _wrap,
+    _style,
+    _styled,
+    figure_size,
+)
 from .exceptions import ParameterError
 
 if TYPE_CHECKING:
@@ -42,13 +67,17 @@ __all__ = [
     "plot_modes",
     "surface_distance",
     "save_figure",
+    "figure_size",
+    "SERIES_STYLES",
+    "STYLE",
+    "rc_context",
 ]
 
 #: Image formats :func:`save_figure` accepts (by file suffix).
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
 
 _MM = 1e3
-_G = 9.80665
+_MS = 1e3
 
 
 @dataclass(frozen=True)
@@ -71,13 +100,28 @@ class PlotHandles:
     lines: tuple[Any, ...]
     artists: dict[str, Any] = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        return f"<PlotHandles: figure with {len(self.axes)} axes, {len(self.lines)} lines>"
+
+    def _repr_mimebundle_(self, include: Any = None, exclude: Any = None) -> dict[str, Any]:
+        """Jupyter shows the figure (PNG), not a text dump."""
+        import io
+
+        buf = io.BytesIO()
+        self.figure.savefig(buf, format="png", dpi=150)
+        return {"image/png": buf.getvalue(), "text/plain": repr(self)}
+
+    def save(self, path: str | os.PathLike[str], *, dpi: int = 300) -> Path:
+        """Write the figure to ``path`` (format from the suffix); see :func:`save_figure`."""
+        return save_figure(self.figure, path, dpi=dpi)
+
 
 # --------------------------------------------------------------------------- helpers
 
 
 def _new_figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
     """A figure on the Agg canvas, independent of pyplot's global state."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    FigureCanvasAgg = require("matplotlib.backends.backend_agg", "plot").FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=figsize, layout="constrained")
@@ -86,8 +130,10 @@ def _new_figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, **
     return fig, axes
 
 
-def save_figure(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 110) -> Path:
+def save_figure(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 300) -> Path:
     """Write ``figure`` to ``path`` atomically (temporary file + :func:`os.replace`).
+
+    ``dpi`` applies to raster formats; ``.pdf``, ``.svg`` and ``.eps`` are vector.
 
     Raises
     ------
@@ -101,12 +147,12 @@ def save_figure(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 110)
     if suffix not in FIGURE_SUFFIXES:
         raise ParameterError(f'figure path: unsupported file type "{p.suffix or p.name}" (use {", ".join(FIGURE_SUFFIXES)})')
     with atomic_path(p) as tmp:
-        meta = {"Software": None} if suffix == ".png" else None
+        meta = {".png": {"Software": None}, ".pdf": {"CreationDate": None}, ".svg": {"Date": None}}.get(suffix)
         figure.savefig(tmp, format=suffix.lstrip("."), dpi=dpi, metadata=meta)
     return p
 
 
-def _finish(handles: PlotHandles, path: str | os.PathLike[str] | None, dpi: int = 110) -> PlotHandles:
+def _finish(handles: PlotHandles, path: str | os.PathLike[str] | None, dpi: int = 300) -> PlotHandles:
     if path is not None:
         save_figure(handles.figure, path, dpi=dpi)
     return handles
@@ -141,7 +187,7 @@ def surface_distance(
     """The paper's plotted deflection: distance from the contactor surface [m], positive away.
 
     With a contactor this is its gap function ``g = c - s w(a, t)`` (``s = +1``
-    for a contactor above, ``-1`` below; DESIGN.md section 1), i.e. ``u + c``
+    for a contactor above, ``-1`` below; see the model page), i.e. ``u + c``
     with ``u`` the metrics' deflection positive away from the contactor:
     negative values mean contact, as in Figs. 4-8 of Xu & Ervin (2013).
     Without a contactor it is ``-s w(x, t)`` at ``x`` (default the first
@@ -158,20 +204,42 @@ def surface_distance(
 # --------------------------------------------------------------------------- one result
 
 
+def _excitation_of(result: Any, excitation: Any) -> Any:
+    if excitation is not None:
+        return excitation
+    sc = getattr(result, "scenario", None)  # when the result carries its scenario
+    return getattr(sc, "excitation", None)
+
+
+def _draw_excitation(ax: Axes, excitation: Any, t: np.ndarray, compact: bool = False) -> Any:
+    label, scale = _EXCITATION_AXIS.get(excitation.kind, ("load", 1.0))
+    if compact:  # the unit alone names the quantity in a one-column panel
+        label = "load " + label[label.index("["):]
+    (line,) = ax.plot(t * _MS, excitation.history(t) * scale, color="0.25", lw=1.0)
+    ax.set_ylabel(label)
+    ax.grid(True, alpha=0.3)
+    return line
+
+
+@_styled
 def plot_result(
     result: SimulationResult,
     path: str | os.PathLike[str] | None = None,
     *,
     ax: Axes | None = None,
     force: bool = True,
+    quantity: Literal["u", "w", "both"] = "u",
+    excitation: Any = None,
+    size: str | tuple[float, float] = "double",
     title: str | None = None,
-    dpi: int = 110,
+    dpi: int = 300,
 ) -> PlotHandles:
-    """Deflection at the first contactor (or first output point) against time.
+    """Response at the first contactor (or first output point) against time [ms].
 
-    Contact intervals are shaded, impacts and rebounds marked at their exact
-    times, the contactor surface drawn as a dashed line, and the contact force
-    shown in a lower panel (or on a twin axis when ``ax`` is given).
+    Panels, top to bottom: the excitation (when known), the response with
+    the contact intervals shaded, impacts and rebounds marked at their exact
+    times and the contactor surface dashed, and the contact force. With
+    ``ax`` only the response is drawn there (the force on ``ax.twinx()``).
 
     Parameters
     ----------
@@ -179,70 +247,106 @@ def plot_result(
     path : path-like, optional
         Write the figure there (atomically); the format follows the suffix.
     ax : Axes, optional
-        Draw the deflection on it; the force goes on ``ax.twinx()``.
     force : bool
         Draw the contact force (only when there is a contactor).
+    quantity : {"u", "w", "both"}
+        ``"u"``: the metrics' deflection, positive away from the first
+        contactor (``u = -w`` above the beam, ``w`` below); ``"w"``: the
+        deflection from rest along +w; ``"both"``: the two, labelled.
+    excitation : Excitation, optional
+        Drawn in a top panel; default the result's scenario's, if it has one.
+    size : {"single", "double"} or (width, height)
+        One journal column (3.5 in) or two (7 in).
     title : str, optional
     dpi : int
+        Resolution of raster files.
 
     Returns
     -------
     PlotHandles
-        ``axes`` = (deflection axes[, force axes]); ``artists`` holds
-        ``contact_spans``, ``impacts``, ``rebounds``, ``surface``.
+        ``axes`` = (response[, force][, excitation]); ``artists`` holds
+        ``contact_spans``, ``impacts``, ``rebounds``, ``surface``, ``legend``.
     """
     from .metrics import contact_intervals
 
+    if quantity not in ("u", "w", "both"):
+        raise ParameterError(f'quantity: must be "u", "w" or "both", got {quantity!r}')
     x, w, where = _contact_point(result)
     has_c = len(result.contactors) > 0
+    sign = -result.contactors[0].direction if has_c else 1.0  # u = sign * w
     show_force = force and has_c
+    excitation = _excitation_of(result, excitation)
+    show_ex = ax is None and excitation is not None and getattr(excitation, "kind", "none") != "none"
+    ax_ex = ax_f = None
     if ax is None:
-        if show_force:
-            fig, grid = _new_figure((8.0, 5.6), 2, 1, sharex=True, height_ratios=[2.2, 1.0])
-            ax_w, ax_f = grid[0, 0], grid[1, 0]
-        else:
-            fig, grid = _new_figure((8.0, 4.2))
-            ax_w, ax_f = grid[0, 0], None
+        heights = ([0.7] if show_ex else []) + [2.0] + ([0.9] if show_force else [])
+        fig, grid = _new_figure(figure_size(size, 0.22 * sum(heights) + 0.12), len(heights), 1, sharex=True,
+                                height_ratios=heights)
+        axs = list(grid[:, 0])
+        ax_ex = axs.pop(0) if show_ex else None
+        ax_w = axs.pop(0)
+        ax_f = axs.pop(0) if show_force else None
     else:
         fig = ax.figure
         ax_w = ax
         ax_f = ax.twinx() if show_force else None
     t = np.asarray(result.time)
-    lines = list(ax_w.plot(t, w * _MM, color="C0", lw=1.2, label=f"w at x = {x * _MM:.4g} mm ({where})"))
+    tm = t * _MS
+    pos = f"x = {x * _MM:.4g} mm"
+    lines = []
+    if quantity in ("u", "both"):
+        lines += ax_w.plot(tm, sign * w * _MM, color="#000000", lw=1.0, label="u" if has_c else "u = w")
+    if quantity in ("w", "both"):
+        lines += ax_w.plot(tm, w * _MM, color="#0072B2", ls="--", lw=1.0, label="w (from rest)")
     artists: dict[str, Any] = {"contact_spans": [], "impacts": None, "rebounds": None, "surface": None}
     if has_c:
         c = result.contactors[0]
-        artists["surface"] = ax_w.axhline(c.direction * c.gap * _MM, color="k", ls="--", lw=0.8, label="contactor surface")
+        ysurf = -c.gap if quantity != "w" else c.direction * c.gap
+        artists["surface"] = ax_w.axhline(ysurf * _MM, color="0.4", ls=(0, (4, 2)), lw=0.8, label="contactor surface")
         t_end = float(t[-1])
         for k, (a, b) in enumerate(contact_intervals(result, 0)):
-            span = ax_w.axvspan(a, min(b, t_end), color="C3", alpha=0.15, lw=0, label="in contact" if k == 0 else None)
+            span = ax_w.axvspan(a * _MS, min(b, t_end) * _MS, color="0.85", lw=0, label="in contact" if k == 0 else None)
             artists["contact_spans"].append(span)
-        for kind, marker, color in (("impact", "v", "C3"), ("rebound", "^", "C2")):
+        ymul = sign if quantity != "w" else 1.0
+        for kind, marker, face in (("impact", "v", "#D55E00"), ("rebound", "^", "none")):
             times = [e.time for e in result.events if e.kind == kind and e.contactor == 0]
             if times:
                 wv = result.displacement([x], times)[0]
-                (m,) = ax_w.plot(times, wv * _MM, ls="none", marker=marker, color=color, ms=5, label=f"{kind}s")
+                (m,) = ax_w.plot(np.asarray(times) * _MS, ymul * wv * _MM, ls="none", marker=marker, ms=4,
+                                 mfc=face, mec="#D55E00", mew=0.8, label=f"{kind}s")
                 artists[f"{kind}s"] = m
         if ax_f is not None:
-            (lf,) = ax_f.plot(t, result.contact_force[:, 0], color="C1", lw=1.0, label="contact force")
+            (lf,) = ax_f.plot(tm, result.contact_force[:, 0], color="#D55E00", ls="-", lw=0.9, label="contact force")
             lines.append(lf)
-            ax_f.set_ylabel("contact force F [N]")
+            ax_f.set_ylabel("contact force F [N]" if size != "single" else "F [N]")
             if ax is None:
-                ax_f.set_xlabel("time t [s]")
                 ax_f.grid(True, alpha=0.3)
-    ax_w.set_ylabel("deflection w [mm]")
-    if ax is not None or ax_f is None:
-        ax_w.set_xlabel("time t [s]")
+    if ax_ex is not None:
+        artists["excitation"] = _draw_excitation(ax_ex, excitation, t, compact=size == "single")
+    ylab = {"u": "u [mm]", "w": "w [mm]", "both": "u, w [mm]"}[quantity]
+    if size != "single":
+        ylab = "deflection " + ylab
+    ax_w.set_ylabel(ylab)
+    bottom = ax_f if (ax is None and ax_f is not None) else ax_w
+    bottom.set_xlabel("time t [ms]")
     ax_w.grid(True, alpha=0.3)
-    artists["legend"] = ax_w.legend(loc="lower right", fontsize=8)
-    ax_w.set_title(title if title is not None else f"{result.scenario_name}: response at x = {x * _MM:.4g} mm")
-    axes = (ax_w,) if ax_f is None else (ax_w, ax_f)
+    side = f", u positive away from the {where}" if has_c and quantity != "w" and size != "single" else ""
+    heading = title if title is not None else f"{result.scenario_name}: response at {pos}{side}"
+    if ax is None:
+        artists["legend"] = _outside_legend(fig, ax_w, ncols=6 if size == "double" else 2)
+        (ax_ex or ax_w).set_title(heading)
+        fig.align_ylabels()
+    else:
+        artists["legend"] = _side_legend(ax_w)
+        ax_w.set_title(heading)
+    axes = tuple(a for a in (ax_w, ax_f, ax_ex) if a is not None)
     return _finish(PlotHandles(fig, axes, tuple(lines), artists), path, dpi)
 
 
 # --------------------------------------------------------------------------- groups of histories
 
 
+@_styled
 def plot_response(
     results: SimulationResult | Sequence[SimulationResult],
     *,
@@ -254,8 +358,9 @@ def plot_response(
     time_window: tuple[float, float] | None = None,
     reference: Sequence[tuple[float, str]] = (),
     title: str | None = None,
+    size: str | tuple[float, float] = "double",
     path: str | os.PathLike[str] | None = None,
-    dpi: int = 110,
+    dpi: int = 300,
 ) -> PlotHandles:
     """Response histories of several runs on one axes (the manner of Figs. 4-8 of the paper).
 
@@ -268,7 +373,8 @@ def plot_response(
     quantity : {"surface", "w"}
         ``"surface"``: distance from the first contactor's surface, positive
         away from it, negative in contact (:func:`surface_distance`; the
-        paper's plotted quantity); ``"w"``: deflection from rest at ``x``.
+        paper's plotted quantity; ``-w`` or ``w`` by ``side`` for a run
+        without contactor); ``"w"``: deflection from rest at ``x``.
     x : float, optional, [m]
         Position for ``"w"`` or for a run without contactor (default: the
         first contactor, else the first output point).
@@ -278,6 +384,7 @@ def plot_response(
     reference : sequence of (value [m], label)
         Horizontal reference lines (e.g. published peak values).
     title : str, optional
+    size : {"single", "double"} or (width, height)
     path : path-like, optional
     dpi : int
 
@@ -290,8 +397,9 @@ def plot_response(
         raise ParameterError(f"labels: {len(labels)} labels for {len(runs)} results")
     if quantity not in ("surface", "w"):
         raise ParameterError(f'quantity: must be "surface" or "w", got {quantity!r}')
-    if ax is None:
-        fig, grid = _new_figure((8.0, 4.2))
+    own = ax is None
+    if own:
+        fig, grid = _new_figure(figure_size(size, 0.5 if size == "double" else 0.8))
         ax = grid[0, 0]
     else:
         fig = ax.figure
@@ -303,24 +411,24 @@ def plot_response(
             sel = (t >= time_window[0]) & (t <= time_window[1])
             t, y = t[sel], y[sel]
         lab = labels[i] if labels is not None else r.scenario_name
-        lines.extend(ax.plot(t, y * _MM, lw=1.1, color=f"C{i % 10}", label=lab))
+        lines.extend(ax.plot(t * _MS, y * _MM, lw=1.0, label=lab, **_style(i)))
     artists: dict[str, Any] = {"reference": []}
-    styles = ("--", ":", "-.")
     for j, (val, lab) in enumerate(reference):
-        artists["reference"].append(ax.axhline(val * _MM, color="0.3", ls=styles[j % 3], lw=0.9, label=lab))
-    if quantity == "surface":
-        artists["surface"] = ax.axhline(0.0, color="k", lw=0.6)
-        ax.set_ylabel("deflection from contactor surface d [mm]\n(positive away; < 0: contact)")
-    else:
-        ax.set_ylabel("deflection w [mm]")
-    ax.set_xlabel("time t [s]")
+        artists["reference"].append(
+            ax.axhline(val * _MM, color="0.45", ls=(0, (1 + 2 * j, 1.5)), lw=0.8, label=lab)
+        )
+    if quantity == "surface" and any(len(r.contactors) for r in runs):
+        artists["surface"] = ax.axhline(0.0, color="0.4", lw=0.5)
+    ax.set_ylabel(_response_label(runs, quantity, side))
+    ax.set_xlabel("time t [ms]")
     ax.grid(True, alpha=0.3)
     if title:
         ax.set_title(title)
-    artists["legend"] = ax.legend(loc="upper right", fontsize=8)
+    artists["legend"] = _outside_legend(fig, ax, ncols=3 if size == "double" else 1) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), artists), path, dpi)
 
 
+@_styled
 def plot_excitation(
     excitations: Sequence[Any],
     *,
@@ -328,42 +436,46 @@ def plot_excitation(
     labels: Sequence[str] | None = None,
     end_time: float = 0.03,
     n: int = 601,
+    size: str | tuple[float, float] = "double",
     path: str | os.PathLike[str] | None = None,
-    dpi: int = 110,
+    dpi: int = 300,
 ) -> PlotHandles:
-    """Base-acceleration histories in g (Fig. 4(a) of the paper).
+    """Load histories against time [ms] (Fig. 4(a) of the paper).
 
     Parameters
     ----------
     excitations : sequence of Excitation
-        ``kind = "base_acceleration"`` (values in m/s^2, shown divided by
-        g = 9.80665 m/s^2).
-    ax, labels, path, dpi
+        Base accelerations are shown in g (9.80665 m/s^2), forces in N or N/m;
+        the axis label follows the first excitation's kind.
+    ax, labels, size, path, dpi
         As :func:`plot_response`.
     end_time : float, [s]
     n : int
         Samples.
     """
-    if ax is None:
-        fig, grid = _new_figure((8.0, 3.2))
+    own = ax is None
+    if own:
+        fig, grid = _new_figure(figure_size(size, 0.3 if size == "double" else 0.6))
         ax = grid[0, 0]
     else:
         fig = ax.figure
     t = np.linspace(0.0, end_time, n)
     lines = []
+    ylabel, scale = _EXCITATION_AXIS.get(excitations[0].kind if excitations else "", ("load", 1.0))
     for i, ex in enumerate(excitations):
         lab = labels[i] if labels is not None else f"excitation {i}"
-        lines.extend(ax.plot(t, ex.history(t) / _G, lw=1.2, color=f"C{i % 10}", label=lab))
-    ax.set_xlabel("time t [s]")
-    ax.set_ylabel("base acceleration [g]")
+        lines.extend(ax.plot(t * _MS, ex.history(t) * scale, lw=1.0, label=lab, **_style(i)))
+    ax.set_xlabel("time t [ms]")
+    ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
-    leg = ax.legend(loc="upper right", fontsize=8)
+    leg = _outside_legend(fig, ax) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
 
 
 # --------------------------------------------------------------------------- studies
 
 
+@_styled
 def plot_parameter_study(
     values: Sequence[float] | np.ndarray,
     metrics: Mapping[str, Sequence[float] | np.ndarray],
@@ -374,8 +486,9 @@ def plot_parameter_study(
     baseline: float | None = None,
     xscale: Literal["linear", "log"] = "linear",
     title: str | None = None,
+    size: str | tuple[float, float] = "double",
     path: str | os.PathLike[str] | None = None,
-    dpi: int = 110,
+    dpi: int = 300,
 ) -> PlotHandles:
     """One panel per metric against one varied parameter (one-at-a-time study).
 
@@ -394,7 +507,9 @@ def plot_parameter_study(
     baseline : float, optional
         Marks the reference value with a vertical dotted line.
     xscale : {"linear", "log"}
+        On a log axis only the decades and 2, 5 times them are labelled.
     title : str, optional
+    size : {"single", "double"} or (width, height)
     path : path-like, optional
     dpi : int
     """
@@ -405,7 +520,8 @@ def plot_parameter_study(
     if axes is None:
         ncols = 2 if len(names) > 1 else 1
         nrows = math.ceil(len(names) / ncols)
-        fig, grid = _new_figure((8.0, 2.4 * nrows + 0.6), nrows, ncols)
+        width = figure_size(size)[0]
+        fig, grid = _new_figure((width, (0.3 if ncols == 2 else 0.55) * width * nrows + 0.3), nrows, ncols)
         axes = list(grid.ravel())
         for extra in axes[len(names):]:
             extra.set_visible(False)
@@ -422,11 +538,15 @@ def plot_parameter_study(
         if y.shape != xv.shape:
             raise ParameterError(f"metrics.{name}: {y.size} values for {xv.size} parameter values")
         ok = np.isfinite(y)
-        lines.extend(a.plot(xv[ok], y[ok], marker="o", ms=4, lw=1.2, color="C0"))
+        lines.extend(a.plot(xv[ok], y[ok], marker="o", ms=3, lw=1.0, color="#000000"))
         if baseline is not None:
-            a.axvline(baseline, color="0.4", ls=":", lw=1.0)
+            a.axvline(baseline, color="0.45", ls=":", lw=0.9)
         a.set_xscale(xscale)
-        a.set_xlabel(parameter_label)
+        if ok.any() and np.all(y[ok] == np.round(y[ok])):  # counts: integer ticks
+            a.yaxis.set_major_locator(require("matplotlib.ticker", "plot").MaxNLocator(integer=True))
+        if xscale == "log":
+            _log_ticks(a.xaxis)
+        a.set_xlabel(_wrap(parameter_label) if len(axes) > 1 else parameter_label)
         a.set_ylabel(labels.get(name, name))
         a.grid(True, alpha=0.3)
     if title:
@@ -434,6 +554,7 @@ def plot_parameter_study(
     return _finish(PlotHandles(fig, tuple(axes), tuple(lines)), path, dpi)
 
 
+@_styled
 def plot_convergence(
     modes: Sequence[int],
     series: Mapping[str, Sequence[float] | np.ndarray],
@@ -441,8 +562,9 @@ def plot_convergence(
     ax: Axes | None = None,
     reference_index: int = -1,
     title: str | None = None,
+    size: str | tuple[float, float] = "single",
     path: str | os.PathLike[str] | None = None,
-    dpi: int = 110,
+    dpi: int = 300,
 ) -> PlotHandles:
     """Relative change of metrics against the number of modes (log scale).
 
@@ -450,8 +572,9 @@ def plot_convergence(
     its value at ``reference_index`` (default: the most modes). The reference
     point itself (zero) is not drawn on the log axis.
     """
-    if ax is None:
-        fig, grid = _new_figure((7.0, 3.8))
+    own = ax is None
+    if own:
+        fig, grid = _new_figure(figure_size(size, 0.8))
         ax = grid[0, 0]
     else:
         fig = ax.figure
@@ -462,16 +585,19 @@ def plot_convergence(
         ref = v[reference_index]
         rel = np.abs(v - ref) / abs(ref) * 100.0 if ref != 0 else np.full_like(v, np.nan)
         ok = np.isfinite(rel) & (rel > 0)
-        lines.extend(ax.plot(n[ok], rel[ok], marker="o", color=f"C{i % 10}", label=name))
+        color, ls, marker = SERIES_STYLES[i % len(SERIES_STYLES)]
+        lines.extend(ax.plot(n[ok], rel[ok], marker=marker, ms=3.5, color=color, ls=ls, label=name))
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
+    _log_ticks(ax.yaxis)
     ax.set_xticks(n, [str(int(k)) for k in n])
+    ax.xaxis.set_minor_locator(require("matplotlib.ticker", "plot").NullLocator())
     ax.set_xlabel("modes per state N [-]")
     ax.set_ylabel(f"change from N = {int(n[reference_index])} [%]")
     ax.grid(True, which="both", alpha=0.3)
     if title:
         ax.set_title(title)
-    leg = ax.legend(fontsize=8)
+    leg = _outside_legend(fig, ax, ncols=1) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
 
 

@@ -1,4 +1,4 @@
-"""Scenario files: TOML <-> validated objects (DESIGN.md section 3).
+"""Scenario files: TOML <-> validated objects (see the scenario reference).
 
 A scenario describes one simulation: the beam and its supports, the
 contactors, damping, the excitation, the initial state, solver options and
@@ -867,7 +867,7 @@ def _parse_output(raw: Mapping[str, Any], beam: Beam, contactors: tuple[Contacto
 
 @dataclass(frozen=True, eq=False)
 class Scenario:
-    """A validated simulation case (DESIGN.md section 3).
+    """A validated simulation case (see the scenario reference).
 
     Attributes
     ----------
@@ -912,6 +912,12 @@ class Scenario:
         """The ``description`` string of the file, if any."""
         return self.data.get("description")
 
+    def _repr_html_(self) -> str:
+        """Compact summary table for Jupyter."""
+        from ._html import scenario_html
+
+        return scenario_html(self)
+
     def with_values(self, values: Mapping[str, Any]) -> Scenario:
         """A new scenario with the dotted paths in ``values`` set, re-validated.
 
@@ -933,7 +939,7 @@ def parse_scenario(
     source: str | os.PathLike[str] | None = None,
     name: str = "scenario",
 ) -> Scenario:
-    """Validate a scenario mapping (the TOML schema of DESIGN.md section 3).
+    """Validate a scenario mapping (the TOML schema of the scenario reference).
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """Parameter studies: sweep files, execution on Dask, labelled results in Zarr that resume.
 
-A *sweep* varies a base scenario (DESIGN.md section 3) through dotted paths
+A *sweep* varies a base scenario (see the scenario reference) through dotted paths
 (``contactors.0.gap``, ``excitation.duration``, ``beam.height``, ...) and
 records, for every case, the scalar response metrics of
 :meth:`impactbeam.SimulationResult.metrics` (the quantities of the paper's
@@ -72,6 +72,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from ._atomic import pid_alive
+from ._optional import require
 from .exceptions import ImpactBeamError, ParameterError, ScenarioError, SimulationError
 from .metrics import METRIC_UNITS
 from .scenario import EXCITATION_DIMENSIONS, Scenario, load_scenario, parse_scenario
@@ -930,7 +931,7 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
     is written), so a sweep of millions of cases starts at once; the Zarr
     encoding sets the on-disk chunks, one per batch.
     """
-    import dask.array as da
+    da = require("dask.array", "sweep")
     import xarray as xr
 
     from . import __version__
@@ -985,7 +986,7 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
         enc["w"] = {"chunks": hchunk, "fill_value": np.nan}
     c0 = spec.base.contactors[0] if spec.base.contactors else None
     where = (
-        "u at the first contactor, positive away from it (DESIGN.md section 3)"
+        "u at the first contactor, positive away from it (u = -w for a contactor above the beam)"
         if c0 is not None
         else "u = w at the first output point"
     )
@@ -1009,7 +1010,7 @@ def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> 
     """Write the empty store (metadata and coordinates); atomic for a directory."""
     ds, enc = _template(spec, chunk)
     if out is None:
-        import zarr
+        zarr = require("zarr", "sweep")
 
         store = zarr.storage.MemoryStore()
         ds.to_zarr(store, compute=False, encoding=enc, consolidated=False)
@@ -1030,7 +1031,7 @@ def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> 
 
 def _open_existing(spec: SweepSpec, out: Path) -> Any:
     """Open a store made by the same sweep, else raise ParameterError."""
-    import zarr
+    zarr = require("zarr", "sweep")
 
     try:
         group = zarr.open_group(str(out), mode="r")
@@ -1120,7 +1121,7 @@ class _Writer:
     """Writes finished batches into the store's chunks (status last)."""
 
     def __init__(self, store: Any, spec: SweepSpec) -> None:
-        import zarr
+        zarr = require("zarr", "sweep")
 
         self.group = zarr.open_group(store, mode="r+")
         self.arrays = {name: self.group[name] for name in (*spec.metrics, "message", "status")}
@@ -1155,6 +1156,8 @@ def run_sweep(
     on_error: Literal["record", "raise"] = "record",
 ) -> SweepRun:
     """Run (or resume) a sweep; like :func:`sweep` but returns a :class:`SweepRun` with counts."""
+    for name in ("zarr", "dask", "distributed"):  # before any work: one clear message
+        require(name, "sweep", feature="parameter sweeps")
     spec = _as_spec(spec_or_path)
     if on_error not in ("record", "raise"):
         raise ParameterError(f'on_error: must be "record" or "raise", got {on_error!r}')
@@ -1289,7 +1292,7 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
     if out_path is not None:
         import warnings
 
-        import zarr
+        zarr = require("zarr", "sweep")
 
         # consolidated metadata lets xr.open_zarr(path) open the finished store without a
         # warning; zarr 3 notes (ZarrUserWarning) that it is an extension of its format 3
@@ -1315,7 +1318,7 @@ def _worker_config() -> dict[str, Any]:
       makes a simulation ~40 % slower.
     * No statistical profiler (it samples the computing thread every 10 ms).
     """
-    import dask
+    dask = require("dask", "sweep")
 
     env = dict(dask.config.get("distributed.nanny.pre-spawn-environ", {}) or {})
     env.pop("MALLOC_TRIM_THRESHOLD_", None)
@@ -1328,8 +1331,9 @@ def _run_dask(
     batches: Iterator[_Batch], done: Any, *, workers: int | None, scheduler: str | None, on_error: str = "record"
 ) -> None:
     """Run the batches on a Dask cluster; ``done(region, result)`` as each finishes."""
-    import dask
-    from distributed import Client, LocalCluster, as_completed
+    dask = require("dask", "sweep")
+    distributed = require("distributed", "sweep")
+    Client, LocalCluster, as_completed = distributed.Client, distributed.LocalCluster, distributed.as_completed
 
     cluster = None
     client = None
@@ -1472,8 +1476,14 @@ def sweep(
 
 
 def _axis_label(ds: Any, name: str) -> str:
-    units = ds[name].attrs.get("units")
-    return f"{name} [{units}]" if units not in (None, "", "1") else name
+    return _axis(ds, name)[0]
+
+
+def _axis(ds: Any, name: str) -> tuple[str, float]:
+    """Display label ("gap [mm]") and the factor from the stored SI values."""
+    from ._plotstyle import display_label
+
+    return display_label(name, ds[name].attrs.get("units"))
 
 
 def select_cases(ds: Any, keep: Sequence[str], sel: Mapping[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
@@ -1537,7 +1547,7 @@ def plot_sweep(
     matplotlib artist
         The Line2D, QuadMesh or PathCollection drawn.
     """
-    import matplotlib.pyplot as plt
+    plt = require("matplotlib.pyplot", "plot")
 
     if metric not in ds.data_vars or metric in ("status", "message", "w"):
         names = [v for v in ds.data_vars if v not in ("status", "message", "w")]
@@ -1550,15 +1560,17 @@ def plot_sweep(
         raise ParameterError("--y: must differ from --x")
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 4.4))
-    label = _axis_label(ds, metric)
+    label, fm = _axis(ds, metric)
+    fx = _axis(ds, x)[1]
+    fy = _axis(ds, y)[1] if y is not None else 1.0
     if "case" in ds.dims:
-        xs = ds[x].values
-        vals = ds[metric].values
+        xs = ds[x].values * fx
+        vals = ds[metric].values * fm
         if y is None:
             handle = ax.scatter(xs, vals, s=10)
             ax.set_ylabel(label)
         else:
-            handle = ax.scatter(xs, ds[y].values, c=vals, s=14, cmap="viridis")
+            handle = ax.scatter(xs, ds[y].values * fy, c=vals, s=14, cmap="viridis")
             ax.figure.colorbar(handle, ax=ax, label=label)
             ax.set_ylabel(_axis_label(ds, y))
         ax.set_xlabel(_axis_label(ds, x))
@@ -1568,14 +1580,15 @@ def plot_sweep(
     da = sub[metric].load()
     numeric_x = da[x].dtype.kind in "fiu"
     if y is None:
-        xs = da[x].values if numeric_x else np.arange(da.sizes[x])
-        (handle,) = ax.plot(xs, da.values, marker="o", ms=3)
+        xs = da[x].values * fx if numeric_x else np.arange(da.sizes[x])
+        (handle,) = ax.plot(xs, da.values * fm, marker="o", ms=3)
         if not numeric_x:
             ax.set_xticks(xs, [str(v) for v in da[x].values])
         ax.set_ylabel(label)
     else:
         da = da.transpose(y, x)
-        handle = ax.pcolormesh(_edges(da[x].values), _edges(da[y].values), da.values, shading="flat", cmap="viridis")
+        handle = ax.pcolormesh(_edges(da[x].values * fx), _edges(da[y].values * fy), da.values * fm, shading="flat",
+                               cmap="viridis")
         ax.figure.colorbar(handle, ax=ax, label=label)
         ax.set_ylabel(_axis_label(ds, y))
     ax.set_xlabel(_axis_label(ds, x))

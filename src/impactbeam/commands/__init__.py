@@ -11,7 +11,7 @@ import importlib
 
 import click
 
-_MODULES = ("reproduce", "sweep", "measure")
+_MODULES = ("reproduce", "sweep", "measure", "explore")
 
 
 def register(main: click.Group) -> None:

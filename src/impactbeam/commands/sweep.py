@@ -20,6 +20,7 @@ from pathlib import Path
 import click
 
 from ..cli import PLOT_SUFFIXES, handle_errors
+from .._optional import require
 from ..exceptions import ParameterError
 
 __all__ = ["COMMANDS", "sweep_command", "plot_command"]
@@ -121,10 +122,7 @@ def plot_command(
         raise ParameterError(f'SWEEP_RESULTS: "{results}" does not exist')
     selection = _parse_sel(sel)
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = require("matplotlib.pyplot", "plot", feature="impactbeam sweep-plot")
     import xarray as xr
 
     from ..sweep import plot_sweep, select_cases

@@ -1,0 +1,165 @@
+"""Generate the scenario reference page from the schema of :mod:`impactbeam.scenario`.
+
+The keys, their nesting, which ones take lists, the allowed choices and the
+support presets are read from the code (``_SCHEMA``, ``_KINDS`` ...), so the
+page cannot drift from what the parser accepts. The one-line meanings are
+kept here in :data:`MEANING`; :func:`check` fails the docs build (and the
+test suite) when a schema key has no meaning or a meaning names a key the
+schema does not have.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from impactbeam import scenario as S
+from impactbeam.beam import SUPPORT_PRESETS
+
+#: Meaning and unit of every leaf key, by dotted path ([] marks the array of tables).
+MEANING: dict[str, str] = {
+    "name": "Name of the case (default: the file stem).",
+    "description": "Free text shown in summaries.",
+    "beam.length": "Beam length L [m].",
+    "beam.width": "Width of the rectangular section [m] (with `height`, instead of `area` and `second_moment`).",
+    "beam.height": "Height of the rectangular section [m], in the direction of w.",
+    "beam.area": "Cross-section area A [m^2] (instead of `width` and `height`).",
+    "beam.second_moment": "Second moment of area I [m^4] (instead of `width` and `height`).",
+    "beam.youngs_modulus": "Young's modulus E [Pa].",
+    "beam.density": "Density rho [kg/m^3].",
+    "supports.left": "Support at x = 0: a preset name or a table of springs.",
+    "supports.left.translational": "Translational spring at x = 0 [N/m] (`inf`: pinned).",
+    "supports.left.rotational": "Rotational spring at x = 0 [N m/rad] (`inf`: no rotation).",
+    "supports.right": "Support at x = L: a preset name or a table of springs.",
+    "supports.right.translational": "Translational spring at x = L [N/m].",
+    "supports.right.rotational": "Rotational spring at x = L [N m/rad].",
+    "contactors[].position": "Contact point a [m] from the left end.",
+    "contactors[].position_ratio": "Contact point as a fraction a/L (instead of `position`).",
+    "contactors[].stiffness": "Contact spring stiffness k [N/m], acting only while engaged.",
+    "contactors[].gap": "Clearance c [m] between the beam at rest and the contactor surface.",
+    "contactors[].side": "Where the contactor is: `below` pushes while w(a) < -gap, `above` while w(a) > gap.",
+    "damping.free": "Modal damping ratio xi_n of the free state (paper eq. 9): one value or one per mode.",
+    "damping.contact": "Modal damping ratio of states with a contactor engaged: one value or one per mode.",
+    "excitation.kind": "What the load is.",
+    "excitation.shape": "Time history: half-sine pulse, step, or a table from `file`.",
+    "excitation.amplitude": "Peak value: [m/s^2] (or g) for base acceleration, [N] point force, [N/m] distributed.",
+    "excitation.duration": "Pulse length [s] (half_sine).",
+    "excitation.start": "When the load begins [s].",
+    "excitation.position": "Point of application of a point force [m].",
+    "excitation.position_ratio": "Point of application as a fraction of L.",
+    "excitation.scale": "Factor on the whole history (fits and sweeps of the load level).",
+    "excitation.file": "CSV or text table of time and value (shape = table), relative to the scenario file.",
+    "excitation.hold": "How a table is held between samples.",
+    "initial.tip_displacement": "Static tip deflection to release from [m] (paper Case 0).",
+    "initial.position": "Where the initial static deflection is imposed [m] (default the tip).",
+    "initial.modal_displacement": "Initial modal coordinates eta_n(0) of the free state (list).",
+    "initial.modal_velocity": "Initial modal velocities d eta_n/dt (0) of the free state (list).",
+    "solver.modes": "Modes per state N (paper: 8).",
+    "solver.time_step": "Output sampling interval [s]; events are located exactly between samples.",
+    "solver.end_time": "Simulated duration [s].",
+    "solver.max_events": "Stop (with a warning) after this many impacts and rebounds: the chattering guard.",
+    "solver.event_tolerance": "Tolerance of the event-time root finder [s].",
+    "solver.projection": "How the modal state is carried across an event: `paper` (default, the L2 projection of eq. 12) or `contact`.",
+    "output.points": "Positions [m] where the response is recorded (list).",
+    "output.point_ratios": "The same as fractions of L (instead of `points`).",
+}
+
+#: Allowed values of the choice keys, read from the parser's own tuples.
+CHOICES: dict[str, tuple[str, ...]] = {
+    "excitation.kind": S._KINDS,
+    "excitation.shape": S._SHAPES,
+    "excitation.hold": S._HOLDS,
+    "contactors[].side": S._SIDES,
+    "supports.left": tuple(SUPPORT_PRESETS),
+    "supports.right": tuple(SUPPORT_PRESETS),
+}
+
+
+def schema_keys() -> list[tuple[str, Any]]:
+    """Every (dotted path, schema node) of the scenario schema, depth first."""
+    out: list[tuple[str, Any]] = []
+
+    def walk(node: Any, prefix: str) -> None:
+        for key, child in node.fields.items():
+            path = f"{prefix}.{key}" if prefix else key
+            if isinstance(child, S._Array):
+                out.append((path + "[]", child))
+                walk(child.item, path + "[]")
+            else:
+                out.append((path, child))
+                if isinstance(child, S._Table):
+                    walk(child, path)
+
+    walk(S._SCHEMA, "")
+    return out
+
+
+def check() -> list[str]:
+    """Problems between the schema and :data:`MEANING` (empty when they agree)."""
+    keys = {p for p, node in schema_keys() if not isinstance(node, S._Array)
+            and not (isinstance(node, S._Table) and not node.preset_ok)}
+    problems = [f"scenario key {k!r} has no meaning in docs/_ext/scenario_reference.py" for k in sorted(keys - set(MEANING))]
+    problems += [f"docs/_ext/scenario_reference.py describes {k!r}, which the schema does not have"
+                 for k in sorted(set(MEANING) - keys)]
+    return problems
+
+
+def _kind(node: Any) -> str:
+    if isinstance(node, S._Table):
+        return "preset name or table" if node.preset_ok else "table"
+    if isinstance(node, S._Array):
+        return "array of tables"
+    if node.list_only:
+        return "list"
+    return "value or list" if node.list_ok else "value"
+
+
+def render() -> str:
+    """The Markdown text of the reference page."""
+    problems = check()
+    if problems:
+        raise RuntimeError("; ".join(problems))
+    lines = [
+        "# Scenario reference",
+        "",
+        "Every key a scenario file accepts, generated from the parser's schema",
+        "(`impactbeam.scenario`). Numbers are SI; a string with a unit is converted",
+        '(`"0.229 mm"`, `"15 g"`, `"1834 MPa"`). Unknown keys are errors that name',
+        "the key and suggest the closest one. `contactors` is an array of tables",
+        "(`[[contactors]]`); its keys are written `contactors[].key` here and",
+        "`contactors.0.key` in sweeps and `with_values`.",
+        "",
+    ]
+    groups: dict[str, list[str]] = {}
+    for path, node in schema_keys():
+        if path not in MEANING:
+            continue
+        top = path.split(".")[0].removesuffix("[]") if "." in path or not isinstance(node, S._Leaf) else ""
+        allowed = ", ".join(f"`{c}`" for c in CHOICES.get(path, ()))
+        default = S.SUPPORT_DEFAULTS.get(path.split(".")[-1]) if path.count(".") == 1 and top == "supports" else None
+        if default:
+            allowed += f" (default `{default}`)"
+        groups.setdefault(top, []).append(f"| `{path}` | {_kind(node)} | {MEANING[path]} | {allowed} |")
+    for top, rows in groups.items():
+        title = f"`[{top}]`" if top else "Top level"
+        if top == "contactors":
+            title = "`[[contactors]]`"
+        lines += [f"## {title}", "", "| key | kind | meaning | allowed |", "|---|---|---|---|", *rows, ""]
+    lines += ["", "## Support presets", "", "| preset | translational [N/m] | rotational [N m/rad] |", "|---|---|---|"]
+    for name, (k, kt) in SUPPORT_PRESETS.items():
+        lines.append(f"| `{name}` | {k:g} | {kt:g} |")
+    lines += ["", "## Example", "", "```{literalinclude} ../../examples/case03.toml", ":language: toml", "```", ""]
+    return "\n".join(lines)
+
+
+def _write(app: Any) -> None:
+    out = Path(app.srcdir) / "_generated" / "scenario-reference.md"
+    out.parent.mkdir(exist_ok=True)
+    text = render()
+    if not out.exists() or out.read_text() != text:  # unchanged files do not trigger a rebuild
+        out.write_text(text)
+
+
+def setup(app: Any) -> dict[str, Any]:
+    app.connect("builder-inited", _write)
+    return {"parallel_read_safe": True, "version": "1"}

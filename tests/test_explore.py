@@ -1,0 +1,168 @@
+"""The live explorer: its model against ``ib.simulate``, and the page in a real browser.
+
+The browser test starts ``python -m impactbeam explore`` on a free port,
+drives headless Chromium (the system package) with Playwright, moves the gap
+slider with the keyboard and checks that the first-impact time shown changes
+and equals ``ib.simulate`` for the gap the page shows. It is skipped, saying
+why, when Panel, Playwright or Chromium is missing.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+import impactbeam as ib
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE3 = ROOT / "examples" / "case03.toml"
+CHROMIUM = shutil.which("chromium") or ("/usr/bin/chromium" if Path("/usr/bin/chromium").exists() else None)
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync"]
+
+
+def test_model_matches_simulate_and_round_trips_toml(tmp_path: Path) -> None:
+    from impactbeam.explore import ExplorerModel
+
+    sc = ib.load_scenario(CASE3)
+    model = ExplorerModel(sc)
+    assert model.values["gap"] == pytest.approx(0.229e-3, rel=1e-12)
+    model.values["gap"] = 0.300e-3
+    model.values["modes"] = 6
+    out = model.run()
+    ref = ib.simulate(sc.with_values({"contactors.0.gap": 0.300e-3, "solver.modes": 6})).metrics()
+    # same scenario, same deterministic solver: equal to round-off
+    assert out["metrics"]["first_impact_time"] == pytest.approx(ref["first_impact_time"], rel=1e-12)
+    assert out["metrics"]["max_response"] == pytest.approx(ref["max_response"], rel=1e-12)
+    # u is -w at a contactor above: its sampled peak is the metric max_response, which is
+    # located between samples. A peak missed by at most dt/2 = 5 us on the first mode
+    # (about 70 Hz) is low by at most (omega dt / 2)^2 / 2 = 2.4e-6 of it; a sign error
+    # would be off by far more.
+    peak = out["u_mm"].max() / (ref["max_response"] * 1e3)
+    assert 1 - 3e-6 < peak <= 1 + 1e-12
+    path = tmp_path / "saved.toml"
+    path.write_text(model.toml())
+    again = ib.load_scenario(path)
+    assert again.contactors[0].gap == pytest.approx(0.300e-3, rel=1e-15) and again.solver.modes == 6
+
+
+def test_envelope_keeps_the_extremes() -> None:
+    import numpy as np
+
+    from impactbeam.explore import envelope
+
+    t = np.linspace(0.0, 1.0, 20001)
+    y = np.sin(2 * np.pi * 37 * t) * np.exp(-t) + (np.abs(t - 0.61803) < 2e-5) * 5.0  # a one-sample spike
+    tt, yy = envelope(t, y, bins=500)
+    assert tt.size <= 3 * 500 + 1 and np.all(np.diff(tt) > 0)
+    assert yy.max() == y.max() and yy.min() == y.min()  # the spike and the trough survive exactly
+    assert tt[0] == t[0] and tt[-1] == t[-1]
+
+
+_CHANGED = """([sel, old]) => {
+    const find = (root) => {
+        const hit = root.querySelector(sel);
+        if (hit) return hit;
+        for (const node of root.querySelectorAll("*")) {
+            if (node.shadowRoot) { const r = find(node.shadowRoot); if (r) return r; }
+        }
+        return null;
+    };
+    const e = find(document);
+    return e !== null && e.textContent !== old;
+}"""
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _seconds(text: str) -> float:
+    value, unit = text.split()
+    return float(value) * {"ms": 1e-3, "s": 1.0}[unit]
+
+
+@pytest.mark.timeout(300)
+def test_explorer_in_headless_chromium(tmp_path: Path) -> None:
+    pytest.importorskip("panel", reason="the explore extra (panel) is not installed")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (pip install playwright)")
+    if CHROMIUM is None:
+        pytest.skip("no Chromium browser: apt-get install chromium (the browser test needs it)")
+    port = _free_port()
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    server = subprocess.Popen(
+        [sys.executable, "-m", "impactbeam", "explore", str(CASE3), "--port", str(port)],
+        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    try:
+        with sync_api.sync_playwright() as pw:
+            ctx = pw.chromium.launch_persistent_context(
+                tempfile.mkdtemp(dir=tmp_path), executable_path=CHROMIUM, headless=True, args=ARGS,
+                viewport={"width": 1300, "height": 1000}, accept_downloads=True,
+            )
+            page = ctx.new_page()
+            deadline = time.monotonic() + 120
+            while True:  # the server needs a moment to start and compile
+                try:
+                    page.goto(f"http://127.0.0.1:{port}/", timeout=10_000)
+                    break
+                except sync_api.Error:
+                    assert server.poll() is None, server.stdout.read()
+                    assert time.monotonic() < deadline, "explorer did not start"
+                    time.sleep(1)
+            first = page.locator("#m-first_impact_time")
+            first.wait_for(timeout=120_000)
+            before = first.inner_text()
+            gap_before = float(page.locator("#v-gap").inner_text())
+            assert gap_before == pytest.approx(0.229, rel=1e-9)
+
+            handle = page.locator(".ib-gap .noUi-handle").first
+            handle.focus()
+            latencies = []
+            for _ in range(5):  # one step of 0.001 mm at a time: the latency of one change
+                old = first.inner_text()
+                t0 = time.perf_counter()
+                page.keyboard.press("ArrowRight")
+                # polled in the page at every animation frame (Panel renders into shadow roots)
+                page.wait_for_function(_CHANGED, arg=["#m-first_impact_time", old], polling="raf", timeout=30_000)
+                latencies.append(time.perf_counter() - t0)
+            latency = sorted(latencies)[2]
+            for _ in range(15):  # 15 more steps at once
+                page.keyboard.press("ArrowRight")
+            time.sleep(1.5)  # let the updates settle on the last value
+            gap_mm = float(page.locator("#v-gap").inner_text())
+            shown = _seconds(first.inner_text())
+            assert gap_mm > gap_before
+            assert first.inner_text() != before
+
+            sc = ib.load_scenario(CASE3)
+            ref = ib.simulate(sc.with_values({"contactors.0.gap": gap_mm * 1e-3})).metrics()["first_impact_time"]
+            # the page prints 4 decimals of ms: agreement to its rounding (5e-8 s)
+            assert shown == pytest.approx(ref, abs=0.51e-7), (gap_mm, shown, ref)
+            update_ms = float(page.locator("#m-update_ms").inner_text().split()[0])
+            print(f"\nexplorer: gap {gap_before} -> {gap_mm} mm, first impact {before} -> {first.inner_text()}; "
+                  f"server update {update_ms:.1f} ms, key-press to redraw (median of 5) {latency * 1e3:.0f} ms, all {[round(x * 1e3) for x in latencies]}")
+
+            with page.expect_download() as info:  # the save button
+                page.locator(".ib-save button").first.click()
+            saved = tmp_path / "saved.toml"
+            info.value.save_as(saved)
+            assert ib.load_scenario(saved).contactors[0].gap == pytest.approx(gap_mm * 1e-3, rel=1e-9)
+            ctx.close()
+    finally:
+        server.terminate()
+        try:
+            server.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            server.kill()
