@@ -167,3 +167,17 @@ def test_sweep_axis_labels_are_readable(name, units, label, scale):
     from impactbeam._plotstyle import display_label
 
     assert display_label(name, units) == (label, scale)
+
+
+def test_result_in_a_notebook_is_a_compact_summary():
+    # repr without arrays; an HTML table of run, contactors, exact metrics and warnings
+    import impactbeam as ib
+
+    from pathlib import Path
+
+    res = ib.simulate(ib.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "case03.toml"))
+    assert len(repr(res)) < 600
+    html = res._repr_html_()
+    assert "max response" in html and "1.0172 mm" in html and "contactor 0" in html
+    assert list(res.impacts.columns) == ["contactor", "start", "end", "duration", "peak_force", "impulse"]
+    assert len(res.impacts) == 12

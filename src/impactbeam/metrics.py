@@ -1,6 +1,6 @@
 """Response metrics of a simulation (the paper's Table 2 quantities and more).
 
-Definitions (DESIGN.md section 3). On ``u = w`` at the first contactor for a
+Definitions (the project's public contract for ``simulate --json``). On ``u = w`` at the first contactor for a
 contactor ``below`` (``u = -w`` for one ``above``; ``u = w`` at the first output
 point without contactor), so that ``u`` is positive away from the contactor:
 

@@ -150,7 +150,7 @@ class SimulationResult:
     options: dict[str, Any] = field(default_factory=dict)
     rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False)
     tolerance: float = 2e-3
-    scenario_text: str | None = field(default=None, repr=False)
+    scenario: Any = field(default=None, repr=False)
 
     # ------------------------------------------------------------------ from the solution
     @property
@@ -222,6 +222,29 @@ class SimulationResult:
     def success(self) -> bool:
         """True when the run reached its end time."""
         return self.status == 0
+
+    def _repr_html_(self) -> str:
+        """Compact summary for Jupyter: run, contactors, metrics, warnings."""
+        from . import _html
+        from .metrics import METRIC_UNITS
+
+        m = self.metrics(impacts=False)
+        scale = {"m": (1e3, "mm"), "s": (1e3, "ms"), "J": (1.0, "J"), "1": (1.0, "")}
+        rows = []
+        for key, unit in METRIC_UNITS.items():
+            v = m.get(key)
+            f, u = scale[unit]
+            rows.append((key.replace("_", " "), "n/a" if v is None else f"{v * f:.5g} {u}".strip()))
+        run = [("scenario", self.scenario_name), ("status", self.message), ("modes per state", self.n_modes),
+               ("events", len(self.events)), ("end time", f"{self.end_time * 1e3:.5g} ms")]
+        cont = [(f"contactor {i}", f"{c.side} at {_html.mm(c.position)}, gap {_html.mm(c.gap)}, k = {c.stiffness:.4g} N/m")
+                for i, c in enumerate(self.contactors)]
+        parts = [_html.table(run, "run"), _html.table(rows, "metrics (exact, from the closed form)")]
+        if cont:
+            parts.insert(1, _html.table(cont, "contactors"))
+        if self.warnings:
+            parts.append(_html.table([("warning", w) for w in self.warnings], "warnings"))
+        return _html.sections("SimulationResult", parts)
 
     # ------------------------------------------------------------------ sampled histories (lazy)
     @functools.cached_property
@@ -448,7 +471,7 @@ class SimulationResult:
                 "warnings": "; ".join(self.warnings),
                 "n_modes": self.n_modes,
                 "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
-                "scenario": self.scenario_text or "",
+                "scenario": self.scenario.to_toml() if self.scenario is not None else "",
                 "metrics": metrics_json(self.metrics()),
                 **{f"solver_{k}": v for k, v in self.options.items()},
             },
@@ -509,6 +532,9 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     suffix = path.suffix.lower()
     if suffix not in RESULT_SUFFIXES:
         raise ParameterError(f"--out: unsupported file type {suffix!r}; use one of {', '.join(RESULT_SUFFIXES)}")
+    from ._optional import require
+
+    require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
     path.parent.mkdir(parents=True, exist_ok=True)
     check_output_size(result.time.size, result.points.size, len(result.contactors), result.n_modes)
     with atomic_path(path) as tmp:

@@ -214,5 +214,5 @@ def simulate(
         progress=progress,
         name=scenario.name,
     )
-    object.__setattr__(res, "scenario_text", scenario.to_toml())
+    object.__setattr__(res, "scenario", scenario)
     return res

@@ -269,7 +269,7 @@ def segment_setup(s, kp, t, eta, deta, reg, dec, om, pw, Wc, smask, gap, side, k
 
     The modal load is ``p_n u(t)`` (paper eq. 8, ``u`` the piece's time law)
     plus, for every engaged contactor with a gap, the constant point force
-    ``side k gap`` at the contactor (DESIGN.md section 1). Fills ``h0, dh0, P``
+    ``side k gap`` at the contactor (the sign convention of the model). Fills ``h0, dh0, P``
     and the load coefficients ``lA, lB, lD``; returns ``(Omega, phi)``.
     """
     tau_p = t - pt0[kp]
