@@ -44,7 +44,7 @@ from ._validation import choice, nonnegative_finite, positive_finite
 from .beam import SUPPORT_PRESETS, Beam, Contactor, Support
 from .exceptions import ParameterError, ScenarioError
 from .loading import Excitation, InitialCondition
-from .solver.options import Damping, SolverOptions
+from .solver.options import BASES, Damping, SolverOptions
 from .units import describe_dimension, scale_decimal, to_si, unit_scale
 
 __all__ = [
@@ -128,7 +128,7 @@ _SCHEMA = _Table(
                 **_leaves("modal_displacement", "modal_velocity", list_ok=True, list_only=True),
             }
         ),
-        "solver": _Table(_leaves("modes", "time_step", "end_time", "max_events", "event_tolerance", "projection")),
+        "solver": _Table(_leaves("modes", "time_step", "end_time", "max_events", "event_tolerance", "projection", "basis")),
         "output": _Table(_leaves("points", "point_ratios", list_ok=True, list_only=True)),
     }
 )
@@ -719,6 +719,8 @@ def _parse_solver(raw: Mapping[str, Any]) -> SolverOptions:
             kw[name] = to_si(s[name], "time", f"solver.{name}")
     if "projection" in s:
         kw["projection"] = _choice("solver.projection", s["projection"], ("contact", "paper"))
+    if "basis" in s:
+        kw["basis"] = _choice("solver.basis", s["basis"], BASES)
     with _relabel("solver"):
         return SolverOptions(**kw)
 

@@ -101,6 +101,22 @@ def initial_coordinates(
     return eta, deta
 
 
+def make_space(beam, contactors, damping, excitation, options: SolverOptions, points) -> StateSpace:
+    """The state space of ``options.basis``: the paper's per-state modes or the shared Ritz basis."""
+    if options.basis == "enriched":
+        from .ritz import RitzStateSpace
+
+        return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points)  # type: ignore[return-value]
+    return StateSpace(beam, contactors, damping, excitation, options.modes, points)
+
+
+def space_initial_coordinates(space, beam: Beam, initial: InitialCondition, n_modes: int):
+    """Free-state (eta, deta) at t = 0 in the basis of ``space``."""
+    if hasattr(space, "initial_coordinates"):
+        return space.initial_coordinates(initial)
+    return initial_coordinates(beam, initial, n_modes)
+
+
 def _segment(st: StateModel, piece: TimePiece, t: float, eta: np.ndarray, deta: np.ndarray) -> ClosedFormSegment:
     tau = t - piece.t0
     p = st.load_weights
@@ -124,7 +140,7 @@ class _Integrator:
     ) -> None:
         self.opt = options
         self.contactors = contactors
-        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, points)
+        self.space = make_space(beam, contactors, damping, excitation, options, points)
         self.pieces = time_pieces(excitation, options.end_time)
         self.gap = np.array([c.gap for c in contactors])
         self.side = np.array([c.direction for c in contactors])
@@ -140,7 +156,7 @@ class _Integrator:
         self.time = np.arange(self.n_out) * dt
         n_p = points.size
         n_c = len(contactors)
-        nm = options.modes
+        nm = self.space.state(()).modes.count
         # filled segment by segment; rows never reached (a run stopped early) become NaN at the end
         self.w = np.empty((self.n_out, n_p))
         self.w_t = np.empty((self.n_out, n_p))
@@ -487,5 +503,5 @@ def integrate(
     if fast.supported(beam, contactors, damping, excitation, options, points, progress):
         return fast.integrate_fast(beam, contactors, damping, excitation, initial, options, points)
     integ = _Integrator(beam, contactors, damping, excitation, initial, options, points, progress)
-    eta, deta = initial_coordinates(beam, initial, options.modes)
+    eta, deta = space_initial_coordinates(integ.space, beam, initial, options.modes)
     return integ._run_from(eta, deta)

@@ -30,7 +30,7 @@ import numpy as np
 from ..beam import Beam, Contactor
 from ..loading import Excitation, InitialCondition, time_pieces
 from . import kernels
-from .engine import Event, RawSolution, Segment, _segment, initial_coordinates
+from .engine import Event, RawSolution, Segment, _segment, make_space, space_initial_coordinates
 from .options import Damping, SolverOptions
 from .states import StateModel, StateSpace
 
@@ -47,8 +47,9 @@ class _Packed:
     def __init__(self, space: StateSpace, states: dict[tuple[int, ...], StateModel], projection: str) -> None:
         nc = len(space.contactors)
         S = 1 << nc
-        nm = space.n_modes
+        nm = space.state(()).modes.count
         npt = space.points.size
+        self.space = space
         self.states = states
         self.keys = [tuple(i for i in range(nc) if (s >> i) & 1) for s in range(S)]
         self.om = np.empty((S, nm))
@@ -109,7 +110,7 @@ def _pack(
     contactors = tuple(contactors)
     pts = np.asarray(points, dtype=float)
     key = (beam, contactors, damping, excitation.kind, excitation.position, options.modes,
-           tuple(pts.tolist()), options.projection)
+           tuple(pts.tolist()), options.projection, options.basis)
     if key in _CACHE:
         return _CACHE[key]
     packed: _Packed | None = None
@@ -119,7 +120,8 @@ def _pack(
     ok = ok and float(np.max(damping.ratios(False, nm))) < 1.0
     ok = ok and (not contactors or float(np.max(damping.ratios(True, nm))) < 1.0)
     if ok:
-        space = StateSpace(beam, contactors, damping, excitation, nm, pts)
+        space = make_space(beam, contactors, damping, excitation, options, pts)
+        nm = space.state(()).modes.count
         states = {}
         for s in range(1 << len(contactors)):
             eng = tuple(i for i in range(len(contactors)) if (s >> i) & 1)
@@ -249,7 +251,7 @@ def integrate_fast(
     pk = _pack(beam, contactors, damping, excitation, options, pts)
     if pk is None or progress is not None:
         raise ValueError("integrate_fast: this problem is not supported by the compiled path; use engine.integrate")
-    nm = options.modes
+    nm = pk.om.shape[1]
     nc = len(contactors)
     npt = pts.size
     T = options.end_time
@@ -266,7 +268,7 @@ def integrate_fast(
     pamp = np.array([p.amp for p in pieces])
     pOm = np.array([p.Omega for p in pieces])
     pphase = np.array([p.phase for p in pieces])
-    eta0, deta0 = initial_coordinates(beam, initial, nm)
+    eta0, deta0 = space_initial_coordinates(pk.space, beam, initial, options.modes)
     time, w, w_t, wc, wtc, kin, strain, lpow, dpow, eta, eta_t = _output_arrays(n_out, npt, nc, nm)
     time[:] = np.arange(n_out) * dt
     code = np.full(n_out, -1, dtype=np.int16)
@@ -306,7 +308,7 @@ def integrate_fast(
     segments = LazySegments(
         seg_t0[:nseg], seg_t1[:nseg], seg_keys, pk.states, pieces, seg_k[:nseg], seg_eta[:nseg], seg_deta[:nseg]
     )
-    space = StateSpace(beam, contactors, damping, excitation, nm, pts)
+    space = make_space(beam, contactors, damping, excitation, options, pts)
     space._states.update(pk.states)
     return RawSolution(
         time, w, w_t, wc, wtc, code, keys, kin, strain, lpow, dpow, eta, eta_t, events, segments,  # type: ignore[arg-type]
