@@ -94,7 +94,7 @@ class SolverOptions:
     max_events: int = 10000
     event_tolerance: float = 1e-13
     projection: str = "paper"
-    basis: str = "paper"
+    basis: str = "enriched"
 
     def __post_init__(self) -> None:
         if self.basis not in BASES:

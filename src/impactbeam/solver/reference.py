@@ -43,7 +43,7 @@ from scipy.integrate import solve_ivp
 from ..beam import Beam, Contactor
 from ..exceptions import SimulationError
 from ..loading import Excitation, InitialCondition
-from .engine import Event, RawSolution, initial_coordinates
+from .engine import Event, RawSolution, make_space, space_initial_coordinates
 from .options import Damping, SolverOptions
 from .states import StateModel, StateSpace
 
@@ -157,7 +157,7 @@ class _Reference:
         self.contactors = contactors
         self.excitation = excitation
         self.opt = options
-        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, points)
+        self.space = make_space(beam, contactors, damping, excitation, options, points)
         self.gap = np.array([c.gap for c in contactors], dtype=float)
         self.side = np.array([c.direction for c in contactors], dtype=float)
         self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
@@ -315,7 +315,7 @@ class _Reference:
 
     # -------------------------------------------------------------- output
     def _sample(self, segments, events, jumps, status, message, t_reached) -> RawSolution:
-        n_out, nm = self.n_out, self.opt.modes
+        n_out, nm = self.n_out, self.space.state(()).modes.count
         npnt, nc = self.space.points.size, len(self.contactors)
         nan = lambda *s: np.full(s, np.nan)  # noqa: E731
         w, w_t = nan(n_out, npnt), nan(n_out, npnt)
@@ -408,5 +408,5 @@ def integrate_ivp(
     location).
     """
     ref = _Reference(beam, tuple(contactors), damping, excitation, options, np.asarray(points, dtype=float))
-    eta, deta = initial_coordinates(beam, initial, options.modes)
+    eta, deta = space_initial_coordinates(ref.space, beam, initial, options.modes)
     return ref.run(eta, deta)
