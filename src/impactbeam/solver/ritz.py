@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -72,6 +73,7 @@ __all__ = ["RitzBasis", "RitzModes", "RitzStateSpace", "ritz_basis"]
 
 _MERGE = 3e-5  # contactors closer than this fraction of L share one attachment shape
 _DROP = 1e-11  # a residual shape smaller than this fraction of its static shape is dropped
+_LOSSY = 1e-12  # below this fraction the residual keeps fewer than ~4 digits (cancellation): warn
 _GX, _GW = np.polynomial.legendre.leggauss(20)
 
 
@@ -169,19 +171,38 @@ class RitzBasis:
                 pos.append(a)
         self._alpha = np.array(pos) / L
         self._x, self._w = self._quadrature()
-        Rq, static_norm = self._residuals_at(self._x, 0, raw=True)  # (n_c, q)
         rhoA = beam.mass_per_length
+        Rq = self._residuals_at(self._x, 0)  # (n_c, q)
+        if self._alpha.size and self.free.count > self.free.n_rigid:
+            # second Gram-Schmidt pass: r_c is a small difference of O(1) shapes
+            # (~N^-3.5 of g_c), so remove what round-off left along the retained modes
+            Fq = self.free.shapes(self._x)[self.free.n_rigid :]
+            self.__dict__["_modal_static"] = self._modal_static + rhoA * (Fq * self._w) @ Rq.T
+            Rq = self._residuals_at(self._x, 0)
         Mrr = rhoA * (Rq * self._w) @ Rq.T
-        keep = np.sqrt(np.maximum(np.diag(Mrr), 0.0)) > _DROP * static_norm
+        gq = self._static_at(self._x, 0)
+        g_norm = np.sqrt(rhoA * (gq**2) @ self._w)
+        r_norm = np.sqrt(np.maximum(np.diag(Mrr), 0.0))
+        keep = r_norm > _DROP * g_norm
+        lossy = keep & (r_norm < _LOSSY * g_norm)
+        if lossy.any():
+            warnings.warn(
+                f"enriched basis: the attachment shape at x = {float(self._alpha[lossy][0] * L):.6g} m is "
+                f"{float((r_norm / g_norm)[lossy].min()):.2g} of its static shape (very soft supports?): it keeps "
+                "fewer than 4 significant digits; consider solver.basis = 'paper'",
+                RuntimeWarning,
+                stacklevel=3,
+            )
         if not keep.all():
             self._alpha = self._alpha[keep]
             self.__dict__.pop("_static", None)
             self.__dict__.pop("_static_q", None)
+            self.__dict__.pop("_modal_static", None)
         Mrr = Mrr[np.ix_(keep, keep)]
         self.positions = self._alpha * L
         n_a = int(keep.sum())
         if n_a:
-            Ra = self._residuals_at(self.positions, 0, raw=True)[0]  # (n_a, n_a): r_c(a_d)
+            Ra = self._residuals_at(self.positions, 0)  # (n_a, n_a): r_c(a_d)
             Krr = 0.5 * (Ra + Ra.T)
             s, U = np.linalg.eigh(Mrr)
             ok = s > 1e-10 * s.max()
@@ -269,27 +290,26 @@ class RitzBasis:
         r = self.free.n_rigid
         return self.beam.mass_per_length * self.free.shapes(self._x)[:r] * self._w
 
-    def _residuals_at(self, x: np.ndarray, derivative: int, raw: bool = False) -> tuple[np.ndarray, float]:
-        """Residual shapes ``r_c`` (raw) at ``x``: (n_c, p), and the largest static M-norm."""
-        x = np.atleast_1d(np.asarray(x, dtype=float))
-        g = self._static_at(x, derivative)
+    @functools.cached_property
+    def _modal_static(self) -> np.ndarray:
+        """``phi_i(a_c) / omega_i^2`` of the elastic retained modes: (N - r, n_c)."""
         ms = self.free
         r = ms.n_rigid
-        Wa = ms.shapes(self._alpha * self.beam.length)[r:]  # (N - r, n_c)
-        om2 = ms.omega[r:] ** 2
-        res = g - (Wa / om2[:, None]).T @ ms.shapes(x, derivative)[r:]
-        norm = 0.0
-        if raw and self._alpha.size:
-            gq = self._static_at(self._x, 0)
-            norm = float(np.sqrt(np.max(self.beam.mass_per_length * (gq**2) @ self._w)))
-        return res, norm
+        return ms.shapes(self._alpha * self.beam.length)[r:] / (ms.omega[r:] ** 2)[:, None]
+
+    def _residuals_at(self, x: np.ndarray, derivative: int) -> np.ndarray:
+        """Residual shapes ``r_c = g_c - sum_i phi_i phi_i(a_c) / omega_i^2`` (or derivatives) at ``x``: (n_c, p)."""
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        g = self._static_at(x, derivative)
+        r = self.free.n_rigid
+        return g - self._modal_static.T @ self.free.shapes(x, derivative)[r:]
 
     def values(self, x: float | Sequence[float] | np.ndarray, derivative: int = 0) -> np.ndarray:
         """The ``N + n_a`` basis functions (or x-derivatives, 0..3) at ``x``: shape (n, p)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         out = self.free.shapes(x, derivative)
         if self._Z.size:
-            R = self._residuals_at(x, derivative)[0]
+            R = self._residuals_at(x, derivative)
             out = np.concatenate([out, self._Z.T @ R])
         return out
 
@@ -403,6 +423,12 @@ class RitzStateSpace:
         self.n_modes = n_modes
         self.points = np.asarray(points, dtype=float).reshape(-1)
         self.positions = np.array([c.position for c in self.contactors], dtype=float)
+        for i, c in enumerate(self.contactors):
+            if not math.isfinite(c.stiffness):
+                raise ParameterError(
+                    f"contactors.{i}.stiffness: a rigid stop cannot be integrated in the enriched basis "
+                    "(solver.basis); give a finite stiffness"
+                )
         self.basis = ritz_basis(beam, self.positions, n_modes)
         self._psi_c = self.basis.values(self.positions) if self.contactors else np.zeros((self.basis.count, 0))
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
