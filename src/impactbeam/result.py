@@ -130,8 +130,10 @@ class SimulationResult:
         ``input_work`` and ``dissipated`` (cumulative, trapezoid rule on the
         samples), ``total`` and ``residual``
         (``total(0) + input_work - dissipated - total``).
-    eta, eta_t : ndarray, (n_t, n_modes)
-        Modal coordinates in the basis of the state at each sample.
+    eta, eta_t : ndarray, (n_t, n_state_modes)
+        Modal coordinates in the basis of the state at each sample (``n_modes``
+        modes, plus one attachment shape per contactor position with the
+        shared Ritz basis, ``solver.basis = "enriched"``).
     status : int
         0 reached end_time; 1 stopped by the chattering guard (later samples NaN).
     message : str
@@ -255,7 +257,7 @@ class SimulationResult:
     def _sampled(self, modal: bool) -> dict[str, np.ndarray]:
         t = self.time
         xs = np.concatenate([self.points, [c.position for c in self.contactors]])
-        nm = self.n_modes
+        nm = self.solution.n_modes  # N, or N + attachment shapes in the shared Ritz basis
         check_output_size(t.size, self.points.size, len(self.contactors), nm, modal)
         out = {
             "w": np.empty((t.size, xs.size)), "w_t": np.empty((t.size, xs.size)),
@@ -454,7 +456,8 @@ class SimulationResult:
                     "contactor", np.array([c.position for c in self.contactors], dtype=float),
                     {"units": "m", "long_name": "contactor position"},
                 ),
-                "mode": ("mode", np.arange(1, self.n_modes + 1, dtype=np.int32), {"long_name": "mode number"}),
+                "mode": ("mode", np.arange(1, self.solution.n_modes + 1, dtype=np.int32),
+                         {"long_name": "mode number"}),
                 "event": ("event", np.arange(len(self.events), dtype=np.int32), {"long_name": "event number"}),
             },
             attrs={
@@ -536,7 +539,7 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
 
     require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    check_output_size(result.time.size, result.points.size, len(result.contactors), result.n_modes)
+    check_output_size(result.time.size, result.points.size, len(result.contactors), result.solution.n_modes)
     with atomic_path(path) as tmp:
         if suffix == ".nc":
             result.to_xarray().to_netcdf(tmp, engine="h5netcdf")

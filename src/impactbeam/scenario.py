@@ -52,8 +52,8 @@ from .beam import (
 )
 from .exceptions import ParameterError, ScenarioError
 from .loading import Excitation, InitialCondition
-from .solver.options import Damping, SolverOptions
-from .units import DIMENSIONS, describe_dimension, to_si, unit_scale
+from .solver.options import BASES, Damping, SolverOptions
+from .units import DIMENSIONS, describe_dimension, scale_decimal, to_si, unit_scale
 
 __all__ = [
     "Scenario",
@@ -144,7 +144,9 @@ _SCHEMA = _Table(
             }
         ),
         "solver": _Table(
-            _leaves("modes", "time_step", "end_time", "max_events", "event_tolerance", "projection", "tolerance")
+            _leaves(
+                "modes", "time_step", "end_time", "max_events", "event_tolerance", "projection", "tolerance", "basis"
+            )
         ),
         "output": _Table(_leaves("points", "point_ratios", list_ok=True, list_only=True)),
     }
@@ -831,6 +833,8 @@ def _parse_solver(raw: Mapping[str, Any]) -> SolverOptions:
             kw[name] = to_si(s[name], "time", f"solver.{name}")
     if "projection" in s:
         kw["projection"] = _choice("solver.projection", s["projection"], ("contact", "paper"))
+    if "basis" in s:
+        kw["basis"] = _choice("solver.basis", s["basis"], BASES)
     with _relabel("solver"):
         return SolverOptions(**kw)
 

@@ -180,10 +180,14 @@ def simulate(
     every mode is integrated in closed form for the half-sine pulse, the step,
     and tables held constant or linear between samples, for any damping ratio
     (including 0, critical and over-damped) and for rigid-body modes.
-    The remaining errors are modal truncation (``solver.modes``), the event
-    time tolerance (``solver.event_tolerance``, 1e-13 s by default), and the
-    projection between the mode sets of two states (paper eq. 12), which is
-    an L2 projection of the displacement and velocity onto N modes.
+    The remaining errors are modal truncation (``solver.modes``) and the event
+    time tolerance (``solver.event_tolerance``, 1e-13 s by default). With
+    ``solver.basis = "enriched"`` (default) all states share one Ritz basis
+    (the free modes plus a static attachment shape per contactor,
+    :mod:`~impactbeam.solver.ritz`) and a switch is exact; with ``"paper"``
+    each state has its own exact modes and a switch is the projection of
+    paper eq. (12), an L2 projection of the displacement and velocity onto N
+    modes, lossy for contactors much stiffer than the retained modes.
 
     Events are located on the closed form, independently of the output
     step: the scan advances by steps that a bound on the second derivative of

@@ -62,6 +62,40 @@ def initial_coordinates(beam: Beam, initial: InitialCondition, n_modes: int) -> 
     return eta, deta
 
 
+def make_space(beam, contactors, damping, excitation, options: SolverOptions, points) -> StateSpace:
+    """The state space of ``options.basis``: the paper's per-state modes or the shared Ritz basis.
+
+    The shared basis needs the static shapes of a uniform beam with end
+    springs; a beam with sections, point masses or interior springs uses the
+    paper's per-state modes (a warning says so).
+    """
+    if options.basis == "enriched" and _uniform(beam):
+        from .ritz import RitzStateSpace
+
+        return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points)  # type: ignore[return-value]
+    if options.basis == "enriched" and contactors:
+        from .._warnings import emit_user_level_warning
+
+        emit_user_level_warning(
+            'solver.basis: the enriched basis does not support [[beam.sections]], [[masses]] or [[springs]] '
+            'yet; using the paper\'s per-state modes (solver.basis = "paper"), which need more modes for stiff '
+            "contactors"
+        )
+    return StateSpace(beam, contactors, damping, excitation, options.modes, points)
+
+
+def _uniform(beam: Beam) -> bool:
+    """The enriched basis's static shapes are those of a uniform beam with end springs only."""
+    return not (beam.sections or beam.masses or beam.springs)
+
+
+def space_initial_coordinates(space, beam: Beam, initial: InitialCondition, n_modes: int):
+    """Free-state (eta, deta) at t = 0 in the basis of ``space``."""
+    if hasattr(space, "initial_coordinates"):
+        return space.initial_coordinates(initial)
+    return initial_coordinates(beam, initial, n_modes)
+
+
 def kernels_cached() -> bool:
     """Whether the compiled solver is in numba's disk cache (False: the next run compiles it)."""
     try:
@@ -91,7 +125,8 @@ class _Packed:
     def __init__(self, space: StateSpace, preserve: bool) -> None:
         self.space = space
         self.preserve = preserve
-        nm = space.n_modes
+        nm = space.state(()).modes.count  # N, or N + attachment shapes in the shared Ritz basis
+        self.n_modes = nm
         nc = len(space.contactors)
         cap = min(4, 1 << nc)
         self.reg = np.zeros((cap, nm), dtype=np.int64)
@@ -130,8 +165,8 @@ class _Packed:
         """Build the state with engaged-contactor bit mask ``mask``; its slot."""
         key = tuple(i for i in range(len(self.space.contactors)) if (mask >> i) & 1)
         st = self.space.state(key)
-        if st.modes.count != self.space.n_modes:
-            raise RuntimeError(f"state {key}: {st.modes.count} modes instead of {self.space.n_modes}")
+        if st.modes.count != self.n_modes:
+            raise RuntimeError(f"state {key}: {st.modes.count} modes instead of {self.n_modes}")
         s = self.nslots
         if s >= self.smask.size:
             n = 2 * self.smask.size
@@ -174,7 +209,7 @@ def pack(
     """The packed problem, from the cache when its modes and transfers are already known."""
     key = (
         beam, tuple((c.position, c.stiffness) for c in contactors), damping, excitation.kind,
-        excitation.position, options.modes, options.projection,
+        excitation.position, options.modes, options.projection, options.basis,
     )
     hit = _CACHE.get(key)
     if hit is not None:
@@ -182,7 +217,7 @@ def pack(
         return hit
     # gaps and sides enter the compiled loop directly: the states do not depend on them
     neutral = tuple(Contactor(c.position, c.stiffness, 0.0, "below") for c in contactors)
-    space = StateSpace(beam, neutral, damping, excitation, options.modes, np.zeros(0))
+    space = make_space(beam, neutral, damping, excitation, options, np.zeros(0))
     packed = _Packed(space, options.projection == "contact")
     _CACHE[key] = packed
     if len(_CACHE) > _CACHE_SIZE:
@@ -261,7 +296,7 @@ def integrate(
     contactors = tuple(contactors)
     _announce_compile()
     pk = pack(beam, contactors, damping, excitation, options)
-    nm = options.modes
+    nm = pk.n_modes
     con = (
         np.array([c.gap for c in contactors], dtype=float),
         np.array([c.direction for c in contactors], dtype=float),
@@ -273,7 +308,7 @@ def integrate(
     fc[_loop.F_LAST_T] = -1.0
     ic = np.zeros(_loop.N_INT, dtype=np.int64)
     ic[[_loop.I_JUST, _loop.I_PENDING, _loop.I_WARN_C]] = -1
-    eta, deta = initial_coordinates(beam, initial, nm)
+    eta, deta = space_initial_coordinates(pk.space, beam, initial, options.modes)
     eta = np.ascontiguousarray(eta, dtype=float)
     deta = np.ascontiguousarray(deta, dtype=float)
     toggles = np.zeros(max(len(contactors), 1), dtype=np.int64)
@@ -329,6 +364,6 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solutio
         packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=events,
         energy_jumps=rec.jumps[:njump].copy(), status=code, message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
-        n_modes=options.modes,
+        n_modes=pk.n_modes,
     )
 

@@ -9,10 +9,12 @@ import numpy as np
 from .._validation import nonnegative_finite, positive_finite
 from ..exceptions import ParameterError
 
-__all__ = ["Damping", "SolverOptions", "MAX_MODES"]
+__all__ = ["BASES", "Damping", "SolverOptions", "MAX_MODES"]
 
 #: Largest number of modes per state (solver.modes, impactbeam modes --count).
 MAX_MODES = 200
+#: Values of ``solver.basis``: the shared enriched Ritz basis, the paper's per-state modes.
+BASES = ("enriched", "paper")
 
 
 def _ratios(name: str, value: float | tuple[float, ...]) -> float | tuple[float, ...]:
@@ -85,6 +87,15 @@ class SolverOptions:
         constrained one injecting more energy. The result's message warns
         when a projection moves a contactor's deflection by more than 5 % of
         its gap.
+    basis : {"enriched", "paper"}
+        ``"paper"``: each state has its own exact modes and a switch is the
+        projection of eq. (12) (``projection`` applies). ``"enriched"``: all
+        states share one Ritz basis, the ``modes`` retained free modes plus one
+        static attachment shape per contactor
+        (:mod:`~impactbeam.solver.ritz`), so every state has
+        ``modes + n_contactors`` modes, its stiffness is exact in the basis and
+        a switch is an exact change of coordinates (no projection loss); it
+        converges with few modes for stiff contactors.
     """
 
     modes: int | str = 8
@@ -94,8 +105,11 @@ class SolverOptions:
     event_tolerance: float = 1e-13
     projection: str = "paper"
     tolerance: float = 2e-3
+    basis: str = "enriched"
 
     def __post_init__(self) -> None:
+        if self.basis not in BASES:
+            raise ParameterError(f"solver.basis: must be 'enriched' or 'paper', got {self.basis!r}")
         if self.projection not in ("contact", "paper"):
             raise ParameterError(f"solver.projection: must be 'contact' or 'paper', got {self.projection!r}")
         if self.modes != "auto":

@@ -44,10 +44,10 @@ from scipy.optimize import brentq
 from ..beam import Beam, Contactor
 from ..exceptions import SimulationError
 from ..loading import Excitation, InitialCondition
-from .engine import initial_coordinates
+from .engine import make_space, space_initial_coordinates
 from .solution import Event, PiecewiseSolution, Samples
 from .options import Damping, SolverOptions
-from .states import StateModel, StateSpace
+from .states import StateModel
 
 __all__ = ["integrate_ivp", "IvpSegment", "IvpDense", "IvpSolution", "RTOL"]
 
@@ -157,7 +157,7 @@ class _Reference:
         self.contactors = contactors
         self.excitation = excitation
         self.opt = options
-        self.space = StateSpace(beam, contactors, damping, excitation, options.modes, np.zeros(0))
+        self.space = make_space(beam, contactors, damping, excitation, options, np.zeros(0))
         self.gap = np.array([c.gap for c in contactors], dtype=float)
         self.side = np.array([c.direction for c in contactors], dtype=float)
         self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
@@ -331,7 +331,7 @@ class IvpSolution(PiecewiseSolution):
         self.warnings = ()
         self.t_end = t_end
         self.contactors = ref.contactors
-        self.n_modes = ref.opt.modes
+        self.n_modes = ref.space.state(()).modes.count
         self._t0 = np.array([seg.t0 for seg in segments])
         self._h = ref.max_step / 8.0
 
@@ -454,5 +454,5 @@ def integrate_ivp(
     location).
     """
     ref = _Reference(beam, tuple(contactors), damping, excitation, options)
-    eta, deta = initial_coordinates(beam, initial, options.modes)
+    eta, deta = space_initial_coordinates(ref.space, beam, initial, options.modes)
     return ref.run(eta, deta)
