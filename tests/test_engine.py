@@ -165,7 +165,9 @@ def test_undamped_resonant_sine():
 
 
 def test_contact_preserving_projection_is_honoured_by_both():
-    args = with_options(with_contactor(problem(), stiffness=64000.0), projection="contact", end_time=0.05)
+    # the paper's basis: with the shared enriched basis every switch is exact and the projection moot
+    args = with_options(with_contactor(problem(), stiffness=64000.0), projection="contact", end_time=0.05,
+                        basis="paper")
     ex, _ = compare(args, t_event=1e-8, r_metric=1e-6)
     paper = run(with_options(args, projection="paper"))
     assert [e.time for e in paper.events] != [e.time for e in ex.events]

@@ -83,8 +83,8 @@ def test_plot_result_on_given_axes(case3):
 
 
 def test_plot_result_without_contactor(case12):
-    h = plot.plot_result(case12)
-    assert len(h.axes) == 1 and h.artists["contact_spans"] == []
+    h = plot.plot_result(case12)  # the result carries its scenario: response and excitation panels
+    assert len(h.axes) == 2 and h.artists["contact_spans"] == []
     h = plot.plot_response(case12)  # no contactor: no "contactor surface" in the label
     assert "contactor" not in h.axes[0].get_ylabel() and "[mm]" in h.axes[0].get_ylabel()
 

@@ -54,12 +54,29 @@ MEANING: dict[str, str] = {
     "initial.position": "Where the initial static deflection is imposed [m] (default the tip).",
     "initial.modal_displacement": "Initial modal coordinates eta_n(0) of the free state (list).",
     "initial.modal_velocity": "Initial modal velocities d eta_n/dt (0) of the free state (list).",
-    "solver.modes": "Modes per state N (paper: 8).",
-    "solver.time_step": "Output sampling interval [s]; events are located exactly between samples.",
+    "solver.modes": "Modes per state N (paper: 8), or `auto`: add modes until the metrics change by less than `solver.tolerance`.",
+    "solver.time_step": "Output sampling interval [s]; events, extrema and metrics do not depend on it.",
     "solver.end_time": "Simulated duration [s].",
     "solver.max_events": "Stop (with a warning) after this many impacts and rebounds: the chattering guard.",
     "solver.event_tolerance": "Tolerance of the event-time root finder [s].",
     "solver.projection": "How the modal state is carried across an event: `paper` (default, the L2 projection of eq. 12) or `contact`.",
+    "solver.tolerance": "Relative change of the Table-2 metrics that counts as converged in the modes (default 2e-3); with `modes = \"auto\"` the stopping rule, otherwise the threshold of the unconverged warning.",
+    "solver.basis": "`enriched` (default): one shared basis, the free modes plus a static attachment shape per contactor, exact switches; `paper`: each state's own modes joined by the projection of eq. 12.",
+    "beam.sections[].length": "Length of this uniform piece [m]; the pieces, in order from x = 0, sum to `beam.length`.",
+    "beam.sections[].width": "Width of this piece [m] (default the `[beam]` value).",
+    "beam.sections[].height": "Height of this piece [m] (default the `[beam]` value).",
+    "beam.sections[].area": "Cross-section area of this piece [m^2].",
+    "beam.sections[].second_moment": "Second moment of area of this piece [m^4].",
+    "beam.sections[].youngs_modulus": "Young's modulus of this piece [Pa].",
+    "beam.sections[].density": "Density of this piece [kg/m^3].",
+    "masses[].position": "Where the point mass is attached [m].",
+    "masses[].position_ratio": "The same as a fraction of L.",
+    "masses[].mass": "Mass of the attached body [kg].",
+    "masses[].rotary_inertia": "Its rotary inertia about the beam's axis of bending [kg m^2] (default 0).",
+    "springs[].position": "Where the permanent interior support is [m].",
+    "springs[].position_ratio": "The same as a fraction of L.",
+    "springs[].translational": "Its translational stiffness [N/m] (`inf`: a rigid prop).",
+    "springs[].rotational": "Its rotational stiffness [N m/rad] (`inf`: no rotation there).",
     "output.points": "Positions [m] where the response is recorded (list).",
     "output.point_ratios": "The same as fractions of L (instead of `points`).",
 }
@@ -114,6 +131,10 @@ def _kind(node: Any) -> str:
     return "value or list" if node.list_ok else "value"
 
 
+#: Arrays of tables at the top level (written ``[[name]]`` in TOML).
+_ARRAYS = {key for key, node in S._SCHEMA.fields.items() if isinstance(node, S._Array)}
+
+
 def render() -> str:
     """The Markdown text of the reference page."""
     problems = check()
@@ -125,8 +146,9 @@ def render() -> str:
         "Every key a scenario file accepts, generated from the parser's schema",
         "(`impactbeam.scenario`). Numbers are SI; a string with a unit is converted",
         '(`"0.229 mm"`, `"15 g"`, `"1834 MPa"`). Unknown keys are errors that name',
-        "the key and suggest the closest one. `contactors` is an array of tables",
-        "(`[[contactors]]`); its keys are written `contactors[].key` here and",
+        "the key and suggest the closest one. `contactors`, `masses`, `springs`",
+        "and `beam.sections` are arrays of tables (`[[contactors]]`,",
+        "`[[beam.sections]]`); their keys are written `contactors[].key` here and",
         "`contactors.0.key` in sweeps and `with_values`.",
         "",
     ]
@@ -142,8 +164,8 @@ def render() -> str:
         groups.setdefault(top, []).append(f"| `{path}` | {_kind(node)} | {MEANING[path]} | {allowed} |")
     for top, rows in groups.items():
         title = f"`[{top}]`" if top else "Top level"
-        if top == "contactors":
-            title = "`[[contactors]]`"
+        if top in _ARRAYS:
+            title = f"`[[{top}]]`"
         lines += [f"## {title}", "", "| key | kind | meaning | allowed |", "|---|---|---|---|", *rows, ""]
     lines += ["", "## Support presets", "", "| preset | translational [N/m] | rotational [N m/rad] |", "|---|---|---|"]
     for name, (k, kt) in SUPPORT_PRESETS.items():
