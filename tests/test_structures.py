@@ -399,11 +399,11 @@ def test_modes_cli_json_and_plot_of_a_structure(tmp_path):
 
 
 def test_plot_modes_marks_the_structure():
-    from impactbeam import plot
+    from impactbeam import modeplot
 
     sc = ib.parse_scenario(__import__("tomllib").loads(STRUCTURE))
     ms = ib.modes(sc).free
-    h = plot.plot_modes(ms, count=4, contactors=sc.contactors)
+    h = modeplot.plot_modes(ms, count=4, contactors=sc.contactors)
     assert len(h.lines) == 4
     x, y = h.lines[1].get_data()
     assert np.abs(y).max() == pytest.approx(1.0)  # scaled to the largest deflection
