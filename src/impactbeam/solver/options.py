@@ -84,9 +84,10 @@ class SolverOptions:
         continuous. Both converge to the same limit as modes are added; for a
         contactor much stiffer than the beam at its position (k L^3/EI >> the
         retained modes' stiffness) neither converges with few modes, the
-        constrained one injecting more energy. The result's message warns
-        when a projection moves a contactor's deflection by more than 5 % of
-        its gap.
+        constrained one injecting more energy. An ImpactBeamWarning (also in
+        ``result.warnings``) says when a projection moves a contactor's
+        deflection by more than 5 % of its gap. With ``basis = "enriched"``
+        every switch is exact and this option has no effect.
     basis : {"enriched", "paper"}
         ``"paper"``: each state has its own exact modes and a switch is the
         projection of eq. (12) (``projection`` applies). ``"enriched"``: all
