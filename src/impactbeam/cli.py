@@ -416,20 +416,11 @@ def _number(value: Any) -> float | None:
     return x if math.isfinite(x) else None
 
 
-# (key, label, scale, unit) of the metrics, in print order
-_METRIC_ROWS = (
-    ("max_response", "max response", 1e3, "mm"),
-    ("t_max", "  at time", 1e3, "ms"),
-    ("free_duration", "free duration", 1e3, "ms"),
-    ("contact_duration", "contact duration", 1e3, "ms"),
-    ("min_response", "min response", 1e3, "mm"),
-    ("first_impact_time", "first impact", 1e3, "ms"),
-    ("n_impacts", "impacts", 1.0, ""),
-    ("max_penetration", "max penetration", 1e3, "mm"),
-)
 
 
 def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
+    from .metrics import METRIC_DISPLAY
+
     if sc.contactors:
         c = sc.contactors[0]
         where = (
@@ -441,7 +432,7 @@ def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
     lines = [f"Simulation of {sc.name!r}: {where}"]
     rows = []
     shown = {"events"}
-    for key, label, scale, unit in _METRIC_ROWS:
+    for key, label, scale, unit in METRIC_DISPLAY:
         if key not in metrics:
             continue
         shown.add(key)

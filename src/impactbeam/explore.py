@@ -32,6 +32,7 @@ import numpy as np
 
 from ._optional import require
 from .exceptions import ParameterError
+from .metrics import METRIC_DISPLAY
 from .scenario import Scenario, parse_scenario
 
 __all__ = ["SLIDERS", "ExplorerModel", "Slider", "build_app", "serve"]
@@ -218,16 +219,6 @@ def _curves(out: dict[str, Any]) -> dict[str, np.ndarray]:
     tf, f = envelope(out["time_ms"], out["force_N"])
     return {"tu": tu, "u": u, "tf": tf, "f": f}
 
-#: (metric key, label, scale, unit) shown in the table
-_METRICS = (
-    ("max_response", "max response u", 1e3, "mm"),
-    ("t_max", "at time", 1e3, "ms"),
-    ("first_impact_time", "first impact", 1e3, "ms"),
-    ("n_impacts", "impacts", 1.0, ""),
-    ("contact_duration", "contact duration", 1e3, "ms"),
-    ("free_duration", "free duration", 1e3, "ms"),
-    ("max_penetration", "max penetration", 1e3, "mm"),
-)
 
 
 def _fmt(value: Any, scale: float, unit: str) -> str:
@@ -244,7 +235,8 @@ def metrics_html(model: ExplorerModel, out: dict[str, Any], update_ms: float | N
     """The metrics table of the page; every value cell has the id ``m-<key>``."""
     from ._html import table
 
-    rows = [(label, _fmt(out["metrics"].get(key), scale, unit), f"m-{key}") for key, label, scale, unit in _METRICS]
+    rows = [(label, _fmt(out["metrics"].get(key), scale, unit), f"m-{key}")
+            for key, label, scale, unit in METRIC_DISPLAY]
     rows.append(("max contact force", f"{float(np.max(out['force_N'], initial=0.0)):.4f} N", "m-max_force"))
     for s in SLIDERS:
         if s.name in model.values:

@@ -32,7 +32,7 @@ import numpy as np
 if TYPE_CHECKING:
     from .result import SimulationResult
 
-__all__ = ["compute_metrics", "contact_intervals", "METRIC_UNITS"]
+__all__ = ["compute_metrics", "contact_intervals", "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
 METRIC_UNITS = {
@@ -47,6 +47,19 @@ METRIC_UNITS = {
     "n_events": "1",
     "energy_residual": "J",
 }
+
+
+#: How summaries show the Table-2 metrics: (key, label, scale, unit), lengths in mm, times in ms.
+METRIC_DISPLAY = (
+    ("max_response", "max response", 1e3, "mm"),
+    ("t_max", "at time", 1e3, "ms"),
+    ("free_duration", "free duration", 1e3, "ms"),
+    ("contact_duration", "contact duration", 1e3, "ms"),
+    ("min_response", "min response", 1e3, "mm"),
+    ("first_impact_time", "first impact", 1e3, "ms"),
+    ("n_impacts", "impacts", 1.0, ""),
+    ("max_penetration", "max penetration", 1e3, "mm"),
+)
 
 
 def contact_intervals(result: SimulationResult, contactor: int = 0) -> list[tuple[float, float]]:

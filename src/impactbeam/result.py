@@ -228,15 +228,11 @@ class SimulationResult:
     def _repr_html_(self) -> str:
         """Compact summary for Jupyter: run, contactors, metrics, warnings."""
         from . import _html
-        from .metrics import METRIC_UNITS
+        from .metrics import METRIC_DISPLAY
 
         m = self.metrics(impacts=False)
-        scale = {"m": (1e3, "mm"), "s": (1e3, "ms"), "J": (1.0, "J"), "1": (1.0, "")}
-        rows = []
-        for key, unit in METRIC_UNITS.items():
-            v = m.get(key)
-            f, u = scale[unit]
-            rows.append((key.replace("_", " "), "n/a" if v is None else f"{v * f:.5g} {u}".strip()))
+        rows = [(label, "n/a" if m.get(key) is None else f"{m[key] * scale:.5g} {unit}".strip())
+                for key, label, scale, unit in METRIC_DISPLAY]
         run = [("scenario", self.scenario_name), ("status", self.message), ("modes per state", self.n_modes),
                ("events", len(self.events)), ("end time", f"{self.end_time * 1e3:.5g} ms")]
         cont = [(f"contactor {i}", f"{c.side} at {_html.mm(c.position)}, gap {_html.mm(c.gap)}, k = {c.stiffness:.4g} N/m")

@@ -452,11 +452,7 @@ class RitzStateSpace:
             Wc = np.ascontiguousarray((Phi.T @ self._psi_c).T) if self.contactors else np.zeros((0, n))
             Wo = np.ascontiguousarray((Phi.T @ self._psi_o).T) if self.points.size else np.zeros((0, n))
             p = Phi.T @ self._p
-            gap_force = np.zeros(n)
-            for i in engaged:
-                c = self.contactors[i]
-                gap_force += c.direction * c.stiffness * c.gap * Wc[i]
-            st = StateModel(engaged, ms, dyn, Wc, Wo, p, gap_force)  # type: ignore[arg-type]
+            st = StateModel(engaged, ms, dyn, Wc, Wo, p)  # type: ignore[arg-type]
             self._states[engaged] = st
         return st
 

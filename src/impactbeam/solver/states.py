@@ -79,8 +79,6 @@ class StateModel:
         Mode shapes at the output points.
     load_weights : ndarray, (n,)
         ``p_n`` with modal load ``p_n u(t)`` (paper eq. 8).
-    gap_force : ndarray, (n,)
-        Modal weights of the constant forces ``s k c`` of engaged gapped contactors.
     """
 
     engaged: tuple[int, ...]
@@ -89,7 +87,6 @@ class StateModel:
     W_contact: np.ndarray
     W_out: np.ndarray
     load_weights: np.ndarray
-    gap_force: np.ndarray
 
     @property
     def omega_max(self) -> float:
@@ -145,11 +142,7 @@ class StateSpace:
         p = spatial_projection(
             self.excitation, ms.shapes, ms.integral(), self.beam.mass_per_length, inertia=ms.inertia_integral()
         )
-        gap_force = np.zeros(n)
-        for i in engaged:
-            c = self.contactors[i]
-            gap_force += c.direction * c.stiffness * c.gap * Wc[i]
-        return StateModel(engaged, ms, dyn, Wc, Wo, p, gap_force)
+        return StateModel(engaged, ms, dyn, Wc, Wo, p)
 
     def projection(self, to: tuple[int, ...], frm: tuple[int, ...]) -> np.ndarray:
         """``P[n, p] = rho A int W_n^to W_p^from dx`` (paper eq. 12)."""
