@@ -16,7 +16,7 @@ In the same run the script times
 * a plain serial Python loop ``ib.simulate(sc.with_values(...)).metrics()``
   over the first ``--serial-cases`` cases of the grid (the baseline, whose
   rate is extrapolated to the whole grid), and
-* :func:`impactbeam.sweep.sweep` into a fresh Zarr store with a local Dask
+* :func:`impactbeam.sweep` into a fresh Zarr store with a local Dask
   cluster of 1 and of 2 worker processes (wall time including the cluster's
   start and shutdown and the Zarr writes),
 
@@ -47,7 +47,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 
 import impactbeam as ib  # noqa: E402
-from impactbeam.sweep import parse_sweep, run_sweep  # noqa: E402
+from impactbeam.sweeps import parse_sweep, run_sweep  # noqa: E402
 
 CASE = Path(__file__).resolve().parents[1] / "examples" / "case03.toml"
 FULL = (25, 20, 20)

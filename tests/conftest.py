@@ -11,3 +11,24 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 # Figures render off-screen; the library itself never chooses a backend.
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+import pytest  # noqa: E402
+
+import specimen  # noqa: E402
+
+
+@pytest.fixture
+def specimen_toml() -> str:
+    """The specimen's ``[beam]`` table and Case-3 contactor as TOML text (see ``specimen.py``)."""
+    return specimen.BEAM + specimen.CONTACTOR
+
+
+@pytest.fixture
+def scenario_file(tmp_path):
+    """A factory writing scenario text into the test's temporary directory: ``scenario_file(text, name)``."""
+
+    def write(text: str, name: str = "case.toml"):
+        return specimen.write_scenario(tmp_path, text, name)
+
+    return write

@@ -490,11 +490,14 @@ class TransientResult:
         return self.total - self.total[0] - self.work + self.dissipated
 
 
-def _pulse(t: float, shape: str, amplitude: float, start: float, duration: float | None) -> float:
+def _pulse(t: float, shape: str, amplitude: float, start: float, duration: float | None,
+           frequency: float | None = None, phase: float = 0.0) -> float:
     if t < start:
         return 0.0
     if shape == "step":
         return amplitude
+    if shape == "harmonic":
+        return amplitude * math.sin(2.0 * math.pi * float(frequency) * (t - start) + phase)
     if shape == "half_sine":
         if duration is None or not duration > 0:
             raise ValueError("half_sine needs a positive duration")
@@ -535,7 +538,9 @@ def fe_transient(
         as the load pushes into it, recorded as an impact at 0).
     load : ``None`` / ``{"kind": "none"}``;
         ``{"kind": "base_acceleration", "amplitude", "duration", "start"=0,
-        "shape"="half_sine"}`` -> distributed load ``-rhoA ug''(t)``, i.e.
+        "shape"="half_sine"}`` (or ``"shape": "harmonic"`` with ``"frequency"``
+        [Hz] and ``"phase"`` [rad]: ``amplitude sin(2 pi f (t - start) + phase)``
+        for t >= start) -> distributed load ``-rhoA ug''(t)``, i.e.
         the consistent vector ``-ug''(t) M r`` (r = unit rigid translation);
         ``{"kind": "point_force", "position", "amplitude", "shape":
         "half_sine"|"step", "duration", "start"=0}``.
@@ -609,17 +614,19 @@ def fe_transient(
         fvec = -(model.M @ r)[free]
         shape = load.get("shape", "half_sine")
         a0_, st_, du_ = float(load["amplitude"]), float(load.get("start", 0.0)), load.get("duration")
+        fr_, ph_ = load.get("frequency"), float(load.get("phase", 0.0))
 
         def amp(t: float) -> float:
-            return _pulse(t, shape, a0_, st_, du_)
+            return _pulse(t, shape, a0_, st_, du_, fr_, ph_)
     elif kind == "point_force":
         fvec = np.zeros(nf)
         fvec[model.reduced_index(2 * model.node_index(load["position"]))] = 1.0
         shape = load.get("shape", "step")
         a0_, st_, du_ = float(load["amplitude"]), float(load.get("start", 0.0)), load.get("duration")
+        fr_, ph_ = load.get("frequency"), float(load.get("phase", 0.0))
 
         def amp(t: float) -> float:
-            return _pulse(t, shape, a0_, st_, du_)
+            return _pulse(t, shape, a0_, st_, du_, fr_, ph_)
     else:
         raise ValueError(f"unknown load kind {kind!r}")
 

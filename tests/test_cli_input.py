@@ -19,18 +19,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from impactbeam.cli import to_jsonable
+from impactbeam._io import to_jsonable
+from specimen import BEAM
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-
-BEAM = """
-[beam]
-length = 0.1092
-width = 9.93e-3
-height = 3.03e-3
-youngs_modulus = 1834e6
-density = 951.98
-"""
 
 
 def _command() -> list[str]:
@@ -82,14 +74,13 @@ BAD = [
 @pytest.mark.parametrize("command", ["simulate", "modes"])
 @pytest.mark.parametrize(("text", "files", "needle"), BAD)
 def test_bad_scenario_exits_2(
-    tmp_path: Path, command: str, text: str, files: dict[str, str], needle: str
+    tmp_path: Path, scenario_file, command: str, text: str, files: dict[str, str], needle: str
 ) -> None:
     # Reason: DESIGN.md section 3 — status 2, one clear line naming the key, no
     # traceback, and (simulate --out) no output file left behind.
     for name, content in files.items():
         (tmp_path / name).write_text(content, encoding="utf-8")
-    scenario = tmp_path / "bad.toml"
-    scenario.write_text(text, encoding="utf-8")
+    scenario = scenario_file(text, "bad.toml")
     out = tmp_path / "result.nc"
     extra = ["--out", str(out), "--json"] if command == "simulate" else ["--json"]
     proc = run(command, scenario, *extra)

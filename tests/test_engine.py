@@ -29,9 +29,9 @@ import numpy as np
 import pytest
 
 import impactbeam as ib
-from impactbeam.beam import Beam, Contactor, Support
-from impactbeam.loading import Excitation
-from impactbeam.solver.options import Damping
+from impactbeam.model.beam import Beam, Contactor, Support
+from impactbeam.model.loading import Excitation
+from impactbeam.model import Damping
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CASES = sorted(EXAMPLES.glob("case[0-9][0-9].toml"))

@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 
 import impactbeam as ib
-from impactbeam.beam import Beam, Contactor
-from impactbeam.loading import Excitation, InitialCondition
-from impactbeam.solver.options import Damping, SolverOptions
+from impactbeam.model.beam import Beam, Contactor
+from impactbeam.model.loading import Excitation, InitialCondition
+from impactbeam.model import Damping, SolverOptions
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

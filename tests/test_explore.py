@@ -4,7 +4,9 @@ The browser test starts ``python -m impactbeam explore`` on a free port,
 drives headless Chromium (the system package) with Playwright, moves the gap
 slider with the keyboard and checks that the first-impact time shown changes
 and equals ``ib.simulate`` for the gap the page shows. It is skipped, saying
-why, when Panel, Playwright or Chromium is missing.
+why, when Panel, Playwright or Chromium is missing. It prints the time from
+key press to redraw as the test driver sees it (with its own round trips);
+``benchmarks/bench_explore.py`` measures the latency inside the page.
 """
 
 from __future__ import annotations
@@ -66,6 +68,38 @@ def test_envelope_keeps_the_extremes() -> None:
     assert tt.size <= 3 * 500 + 1 and np.all(np.diff(tt) > 0)
     assert yy.max() == y.max() and yy.min() == y.min()  # the spike and the trough survive exactly
     assert tt[0] == t[0] and tt[-1] == t[-1]
+
+
+def test_page_update_sends_the_new_run() -> None:
+    pytest.importorskip("panel", reason="the explore extra (panel) is not installed")
+    import numpy as np
+
+    from impactbeam.explore import ExplorerPage, envelope_index
+
+    sc = ib.load_scenario(CASE3)
+    page = ExplorerPage(sc)
+    assert page.set_value("gap", 0.300)  # the slider shows mm
+    ref = ib.simulate(sc.with_values({"contactors.0.gap": 0.300e-3}))
+    u = -ref.displacement([sc.contactors[0].position], ref.time)[0] * 1e3  # u = -w above, mm
+    force = ref.contact_force[:, 0]
+    idx = envelope_index([u, force])
+    data = page.source.data
+    assert data["t"].dtype == np.float32 and 1000 < data["t"].size < 7000
+    # the plotted columns are the result's own samples (float32), extremes included
+    np.testing.assert_allclose(data["t"], ref.time[idx] * 1e3, rtol=1e-6)
+    np.testing.assert_allclose(data["u"], u[idx], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(data["f"], force[idx], rtol=1e-6, atol=1e-9)
+    assert data["u"].max() == np.float32(u.max()) and data["f"].max() == np.float32(force.max())
+    assert page.u_range.start < u.min() and page.u_range.end > u.max()
+    shown = re.search(r'id="m-first_impact_time">([^<]*)<', page.table.text).group(1)
+    assert _seconds(shown) == pytest.approx(ref.metrics()["first_impact_time"], abs=0.51e-7)
+
+    # a value the scenario rejects is not applied, and the slider goes back
+    assert not page.set_value("modes", 0)
+    assert "Not applied" in page.status.text and "solver.modes" in page.status.text
+    assert page.model.values["modes"] == 8 and page.sliders["modes"].value == 8
+    assert page.set_value("modes", 6) and page.status.text == ""
+    assert page.prepare_modes(7) and not page.prepare_modes(7)  # once per set of values
 
 
 _CHANGED = """([sel, old]) => {
@@ -152,7 +186,7 @@ def test_explorer_in_headless_chromium(tmp_path: Path) -> None:
             assert shown == pytest.approx(ref, abs=0.51e-7), (gap_mm, shown, ref)
             update_ms = float(page.locator("#m-update_ms").inner_text().split()[0])
             print(f"\nexplorer: gap {gap_before} -> {gap_mm} mm, first impact {before} -> {first.inner_text()}; "
-                  f"server update {update_ms:.1f} ms, key-press to redraw (median of 5) {latency * 1e3:.0f} ms, all {[round(x * 1e3) for x in latencies]}")
+                  f"server update {update_ms:.1f} ms, key press to redraw seen by the driver (median of 5) {latency * 1e3:.0f} ms, all {[round(x * 1e3) for x in latencies]}")
 
             with page.expect_download() as info:  # the save button
                 page.locator(".ib-save button").first.click()

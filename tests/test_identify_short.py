@@ -23,7 +23,7 @@ import pytest
 
 import impactbeam as ib
 from impactbeam import experiment as ex
-from impactbeam.damping import damping_matrix_pencil, damping_sine_fit
+from impactbeam.experiment.damping import damping_matrix_pencil, damping_sine_fit
 from impactbeam.exceptions import ParameterError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -144,7 +144,7 @@ def test_identify_refuses_a_record_without_oscillation(tmp_path: Path, values: s
 
 def test_fit_failure_falls_back_to_the_pencil_with_a_warning(short_decay, monkeypatch) -> None:
     """A fit that does not converge is reported as n/a (None in JSON) with a warning, not as an error."""
-    import impactbeam.damping as dmp
+    import impactbeam.experiment.damping as dmp
 
     def fail(*args, **kwargs):
         raise ParameterError("damping fit: did not converge (test)")

@@ -132,7 +132,7 @@ def test_sweep_stops_on_signal_and_keeps_finished_cases(tmp_path, sig, code):
 
 def test_stale_temporary_files_of_killed_writers_are_removed(tmp_path):
     # a writer killed with SIGKILL cannot clean up; the next write to the same target does
-    from impactbeam._atomic import write_text
+    from impactbeam._io import write_text
 
     target = tmp_path / "out.toml"
     dead = 2**22 + 4321

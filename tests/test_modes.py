@@ -1,4 +1,4 @@
-"""Tests of the exact modal analysis in :mod:`impactbeam.modes`.
+"""Tests of the exact modal analysis in :mod:`impactbeam.modal`.
 
 Every reference value is computed independently of ``modes.py``:
 
@@ -26,8 +26,8 @@ import pytest
 from scipy.optimize import brentq
 
 from fe_reference import fe_modes
-from impactbeam.beam import Beam, Support
-from impactbeam.modes import count_below, mode_set
+from impactbeam.model.beam import Beam, Support
+from impactbeam.modal import count_below, mode_set
 
 PI = math.pi
 EPS = np.finfo(float).eps

@@ -310,9 +310,10 @@ def test_reproduce_cli(tmp_path):
     """The whole command (about 20-40 s here: a second full run, hence slow)."""
     from click.testing import CliRunner
 
-    from impactbeam.commands.reproduce import COMMANDS, reproduce
+    from impactbeam.cli import main
+    from impactbeam.cli.cmd_reproduce import reproduce
 
-    assert reproduce in COMMANDS
+    assert main.commands["reproduce"] is reproduce
     out = tmp_path / "rep"
     res = CliRunner().invoke(reproduce, ["--out", str(out), "--quiet"])
     assert res.exit_code == 0, res.output
@@ -324,7 +325,7 @@ def test_reproduce_cli(tmp_path):
 def test_reproduce_cli_bad_out(tmp_path):
     from click.testing import CliRunner
 
-    from impactbeam.commands.reproduce import reproduce
+    from impactbeam.cli.cmd_reproduce import reproduce
 
     f = tmp_path / "file"
     f.write_text("x")

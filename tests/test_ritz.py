@@ -46,7 +46,7 @@ from scipy.optimize import brentq
 import fe_reference as fr
 import impactbeam as ib
 from impactbeam.exceptions import ParameterError
-from impactbeam.modes import mode_set
+from impactbeam.modal import mode_set
 from impactbeam.solver.ritz import RitzStateSpace, ritz_basis
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -197,9 +197,9 @@ def test_basis_key_is_validated():
 
 
 def test_paper_reproduction_keeps_the_paper_method():
-    from impactbeam import paper
+    from impactbeam.paper.plan import _table1_scenarios
 
-    scs = paper._table1_scenarios()
+    scs = _table1_scenarios()
     assert {sc.solver.basis for sc in scs.values()} == {"paper"}
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from impactbeam.beam import Contactor
+from impactbeam.model.beam import Contactor
 from impactbeam.exceptions import ParameterError, ScenarioError
 from impactbeam.scenario import (
     Scenario,
@@ -27,24 +27,9 @@ from impactbeam.scenario import (
 )
 from impactbeam.units import STANDARD_GRAVITY, to_si
 
+from specimen import BEAM, CONTACTOR
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-
-BEAM = """
-[beam]
-length = 0.1092
-width = 9.93e-3
-height = 3.03e-3
-youngs_modulus = 1834e6
-density = 951.98
-"""
-
-CONTACTOR = """
-[[contactors]]
-position_ratio = 0.4840
-stiffness = 4030
-gap = 0.229e-3
-side = "above"
-"""
 
 PULSE = """
 [excitation]
@@ -52,12 +37,6 @@ kind = "base_acceleration"
 amplitude = "15 g"
 duration = "15 ms"
 """
-
-
-def write(tmp_path: Path, text: str, name: str = "case.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(text, encoding="utf-8")
-    return path
 
 
 # --------------------------------------------------------------------------- examples
@@ -307,25 +286,25 @@ modal_velocity = [0, 0.5]
     assert sc.initial.modal_displacement == (1e-4, 0.0) and sc.initial.modal_velocity == (0.0, 0.5)
 
 
-def test_name_and_description(tmp_path: Path) -> None:
+def test_name_and_description(tmp_path: Path, scenario_file) -> None:
     # Reason: the name is the file stem unless the file gives one.
-    sc = load_scenario(write(tmp_path, BEAM, "my_case.toml"))
+    sc = load_scenario(scenario_file(BEAM, "my_case.toml"))
     assert sc.name == "my_case" and sc.description is None
-    sc = load_scenario(write(tmp_path, 'name = "x"\ndescription = "d"\n' + BEAM, "other.toml"))
+    sc = load_scenario(scenario_file('name = "x"\ndescription = "d"\n' + BEAM, "other.toml"))
     assert sc.name == "x" and sc.description == "d"
 
 
 # --------------------------------------------------------------------------- trace tables
 
 
-def test_table_excitation_with_units(tmp_path: Path) -> None:
+def test_table_excitation_with_units(tmp_path: Path, scenario_file) -> None:
     # Reason: header units convert the trace to SI; the file is relative to the scenario.
     (tmp_path / "data").mkdir()
     (tmp_path / "data" / "trace.csv").write_text(
         "# shaker record\ntime [ms],acceleration [g]\n0,0\n0.5,1.5\n\n1.0,3\n", encoding="utf-8"
     )
     text = BEAM + '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "data/trace.csv"\nhold = "linear"\n'
-    sc = load_scenario(write(tmp_path, text))
+    sc = load_scenario(scenario_file(text))
     ex = sc.excitation
     np.testing.assert_array_equal(ex.times, [0.0, 0.5e-3, 1e-3])
     np.testing.assert_array_equal(ex.values, [0.0, 1.5 * 9.80665, 3 * 9.80665])
@@ -531,12 +510,12 @@ BAD = [
 
 
 @pytest.mark.parametrize(("text", "files", "key"), BAD)
-def test_bad_input(tmp_path: Path, text: str, files: dict[str, str], key: str) -> None:
+def test_bad_input(tmp_path: Path, scenario_file, text: str, files: dict[str, str], key: str) -> None:
     # Reason: DESIGN.md section 3 — bad input is reported naming the key, never a
     # traceback or a silent default. ScenarioError is a ParameterError and a ValueError.
     for name, content in files.items():
         (tmp_path / name).write_text(content, encoding="utf-8")
-    path = write(tmp_path, text)
+    path = scenario_file(text)
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
     message = str(info.value)
@@ -546,27 +525,27 @@ def test_bad_input(tmp_path: Path, text: str, files: dict[str, str], key: str) -
     assert isinstance(info.value, ParameterError) and isinstance(info.value, ValueError)
 
 
-def test_unknown_key_suggestion(tmp_path: Path) -> None:
+def test_unknown_key_suggestion(tmp_path: Path, scenario_file) -> None:
     # Reason: the message format other tools and users rely on.
     with pytest.raises(ScenarioError) as info:
-        load_scenario(write(tmp_path, BEAM.replace("length", "lenght")))
+        load_scenario(scenario_file(BEAM.replace("length", "lenght")))
     assert str(info.value) == 'unknown key "beam.lenght" (did you mean "beam.length"?)'
     assert info.value.key == "beam.lenght"
 
 
-def test_off_beam_message(tmp_path: Path) -> None:
+def test_off_beam_message(tmp_path: Path, scenario_file) -> None:
     # Reason: the exact form promised in the brief and in examples/README.md.
     with pytest.raises(ScenarioError) as info:
-        load_scenario(write(tmp_path, BEAM + "[[contactors]]\nposition = 0.2\nstiffness = 4030\n"))
+        load_scenario(scenario_file(BEAM + "[[contactors]]\nposition = 0.2\nstiffness = 4030\n"))
     assert str(info.value) == "contactors.0.position: 0.2 m is off the beam (length 0.1092 m)"
 
 
-def test_trace_error_names_file_and_line(tmp_path: Path) -> None:
+def test_trace_error_names_file_and_line(tmp_path: Path, scenario_file) -> None:
     # Reason: a user must find the bad row in a long measured trace.
     (tmp_path / "t.csv").write_text("time,value\n0,0\n0.001,1\n0.0005,2\n", encoding="utf-8")
     text = BEAM + '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "t.csv"\n'
     with pytest.raises(ScenarioError, match=r'^excitation\.file: "t\.csv" line 4, column 1 \(time\): time 0\.0005 s'):
-        load_scenario(write(tmp_path, text))
+        load_scenario(scenario_file(text))
 
 
 def test_parameter_error_from_data_class_is_relabelled() -> None:
@@ -582,10 +561,10 @@ def test_parameter_error_from_data_class_is_relabelled() -> None:
     assert info.value.key == "contactors.0.stiffness"
 
 
-def test_toml_syntax_error(tmp_path: Path) -> None:
+def test_toml_syntax_error(tmp_path: Path, scenario_file) -> None:
     # Reason: a syntax error names the file and the parser's line.
     with pytest.raises(ScenarioError, match=r'bad\.toml.*invalid TOML.*line 3'):
-        load_scenario(write(tmp_path, "[beam]\nlength = 1\nwidth =\n", "bad.toml"))
+        load_scenario(scenario_file("[beam]\nlength = 1\nwidth =\n", "bad.toml"))
 
 
 def test_missing_scenario_file(tmp_path: Path) -> None:
@@ -601,3 +580,20 @@ def test_common_unit_table_agrees_with_pint():
     for (unit, dimension), factor in units.COMMON_UNITS.items():
         q = units._parse(unit, dimension)
         assert units._quantity_to_si(q, unit, dimension) == factor, (unit, dimension)
+
+
+@pytest.mark.parametrize(
+    ("values", "key"),
+    [
+        ({"beam.theory": "timoshenko"}, "beam.theory"),
+        ({"beam.theory": "rayleigh"}, "beam.theory"),
+        ({"beam.shear_coefficient": 0.85}, "beam.shear_coefficient"),
+    ],
+)
+def test_beam_theory_is_euler_bernoulli_or_refused_by_name(values: dict, key: str) -> None:
+    # Reason: a Timoshenko request must not be ignored (the beam would silently stay Euler-Bernoulli)
+    sc = parse_scenario(tomllib.loads(BEAM))
+    assert sc.with_values({"beam.theory": "euler-bernoulli"}).beam == sc.beam
+    with pytest.raises(ScenarioError) as err:
+        sc.with_values(values)
+    assert err.value.key == key and str(err.value).startswith(key)

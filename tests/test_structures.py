@@ -29,8 +29,8 @@ from scipy.optimize import brentq
 from test_cli_input import assert_one_error_line, run
 
 import impactbeam as ib
-from impactbeam.beam import InteriorSpring, PointMass, Section
-from impactbeam.modes import count_below
+from impactbeam.model.beam import InteriorSpring, PointMass, Section
+from impactbeam.modal import count_below
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 INF = math.inf

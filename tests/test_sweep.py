@@ -33,10 +33,7 @@ from click.testing import CliRunner
 import impactbeam as ib
 from impactbeam.exceptions import ScenarioError
 from impactbeam.metrics import METRIC_UNITS
-from impactbeam.sweep import (
-    _chunk_shape,
-    _make_batch,
-    _regions,
+from impactbeam.sweeps import (
     load_sweep,
     parse_sweep,
     plot_sweep,
@@ -44,6 +41,7 @@ from impactbeam.sweep import (
     run_sweep,
     sweep,
 )
+from impactbeam.sweeps.batches import _chunk_shape, _make_batch, _regions
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CASE3 = EXAMPLES / "case03.toml"
@@ -67,25 +65,19 @@ SCALARS = tuple(METRIC_UNITS)
 
 
 def _cli() -> list[str]:
-    """The installed ``impactbeam`` once ``sweep`` is registered, else the commands via a shim."""
-    from impactbeam.cli import main
-
+    """The installed ``impactbeam`` script, else the command group through this interpreter."""
     script = shutil.which("impactbeam", path=str(BIN))
-    if script and "sweep" in main.commands:
+    if script:
         return [script]
-    shim = (
-        "import sys, click; from impactbeam.commands.sweep import COMMANDS; "
-        "click.Group(commands={c.name: c for c in COMMANDS})(sys.argv[1:], prog_name='impactbeam')"
-    )
-    return [sys.executable, "-c", shim]
+    return [sys.executable, "-m", "impactbeam"]
 
 
 def _group():
     import click
 
-    from impactbeam.commands.sweep import COMMANDS
+    from impactbeam.cli.cmd_sweep import plot_command, sweep_command
 
-    return click.Group(commands={c.name: c for c in COMMANDS})
+    return click.Group(commands={c.name: c for c in (sweep_command, plot_command)})
 
 
 def _write(tmp: Path, name: str, text: str) -> Path:
@@ -196,7 +188,7 @@ values = [0.01]
     assert chunk == (1, 3, 1)  # 5 gaps in two equal-ish batches (3 + 2), one height each
     regions = list(_regions(spec.shape, chunk))
     assert len(regions) == 4  # 2 heights x 2 gap batches
-    from impactbeam.modes import _cached
+    from impactbeam.modal import _cached
     from impactbeam.solver.ritz import _cached_basis  # the shared basis of solver.basis = "enriched"
 
     from impactbeam.solver import engine

@@ -3,7 +3,7 @@
 Issue: a trace with the header ``time (ms),acceleration (g)`` was read as
 seconds and m/s^2 (parentheses were not recognised by the trace reader),
 while the record reader applied them. Both now go through
-``impactbeam._textdata``; these tests check the units reach the simulation.
+``impactbeam._io``; these tests check the units reach the simulation.
 """
 
 from __future__ import annotations
@@ -19,21 +19,9 @@ import impactbeam as ib
 from impactbeam import experiment as ex
 from impactbeam.exceptions import ParameterError
 from impactbeam.units import STANDARD_GRAVITY
+from specimen import BEAM, CONTACTOR
 
-SCENARIO = """
-[beam]
-length = 0.1092
-width = 9.93e-3
-height = 3.03e-3
-youngs_modulus = 1834e6
-density = 951.98
-
-[[contactors]]
-position_ratio = 0.4840
-stiffness = 4030
-gap = 0.229e-3
-side = "above"
-
+SCENARIO = BEAM + CONTACTOR + """
 [excitation]
 kind = "base_acceleration"
 shape = "table"

@@ -13,8 +13,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from impactbeam import scenario as S
-from impactbeam.beam import SUPPORT_PRESETS
+from impactbeam.scenario import schema as S
+from impactbeam.model.beam import SUPPORT_PRESETS
 
 #: Meaning and unit of every leaf key, by dotted path ([] marks the array of tables).
 MEANING: dict[str, str] = {
@@ -41,9 +41,11 @@ MEANING: dict[str, str] = {
     "damping.free": "Modal damping ratio xi_n of the free state (paper eq. 9): one value or one per mode.",
     "damping.contact": "Modal damping ratio of states with a contactor engaged: one value or one per mode.",
     "excitation.kind": "What the load is.",
-    "excitation.shape": "Time history: half-sine pulse, step, or a table from `file`.",
+    "excitation.shape": "Time history: half-sine pulse, step, harmonic, or a table from `file`.",
     "excitation.amplitude": "Peak value: [m/s^2] (or g) for base acceleration, [N] point force, [N/m] distributed.",
     "excitation.duration": "Pulse length [s] (half_sine).",
+    "excitation.frequency": "Forcing frequency f [Hz] (harmonic): amplitude sin(2 pi f (t - start) + phase) for t >= start.",
+    "excitation.phase": "Phase of the harmonic load at `start` [rad] (default 0; `\"90 deg\"` accepted).",
     "excitation.start": "When the load begins [s].",
     "excitation.position": "Point of application of a point force [m].",
     "excitation.position_ratio": "Point of application as a fraction of L.",
@@ -77,8 +79,16 @@ MEANING: dict[str, str] = {
     "springs[].position_ratio": "The same as a fraction of L.",
     "springs[].translational": "Its translational stiffness [N/m] (`inf`: a rigid prop).",
     "springs[].rotational": "Its rotational stiffness [N m/rad] (`inf`: no rotation there).",
+    "beam.theory": '`"euler-bernoulli"` (default, the paper\'s beam). `"timoshenko"` is refused with a clear message '
+                   "in this version.",
+    "beam.poisson_ratio": "Timoshenko beams only (refused otherwise).",
+    "beam.shear_modulus": "Timoshenko beams only (refused otherwise).",
+    "beam.shear_coefficient": "Timoshenko beams only (refused otherwise).",
     "output.points": "Positions [m] where the response is recorded (list).",
     "output.point_ratios": "The same as fractions of L (instead of `points`).",
+    "output.fields": "Fields of result files: `displacement` and `velocity` (always written), `moment` [N m] "
+                     "and `stress` [Pa] (also spelt `bending_moment`, `bending_stress`); `stress` also adds the "
+                     "largest stress, its time and place, to the metrics. List; default none.",
 }
 
 #: Allowed values of the choice keys, read from the parser's own tuples.
@@ -87,6 +97,7 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "excitation.shape": S._SHAPES,
     "excitation.hold": S._HOLDS,
     "contactors[].side": S._SIDES,
+    "output.fields": S.OUTPUT_FIELDS,
     "supports.left": tuple(SUPPORT_PRESETS),
     "supports.right": tuple(SUPPORT_PRESETS),
 }

@@ -6,6 +6,21 @@ transient response of an impacting beam", Shock and Vibration 20 (2013).
 The public names below are imported on first use (PEP 562), so that
 ``import impactbeam`` and the command line start quickly; ``dir(impactbeam)``
 and ``from impactbeam import X`` work as usual.
+
+Example: the paper's specimen (Table 1) against a soft contactor at 0.484 L,
+driven by a 15 g, 15 ms half-sine base pulse:
+
+>>> import impactbeam as ib
+>>> sc = ib.parse_scenario({
+...     "beam": {"length": "109.2 mm", "width": "9.93 mm", "height": "3.03 mm",
+...              "youngs_modulus": "1834 MPa", "density": "951.98 kg/m^3"},
+...     "contactors": [{"position_ratio": 0.484, "stiffness": "4030 N/m", "gap": "0.229 mm", "side": "above"}],
+...     "excitation": {"kind": "base_acceleration", "amplitude": "15 g", "duration": "15 ms"},
+...     "solver": {"modes": 6, "end_time": "50 ms"},
+... })
+>>> m = ib.simulate(sc).metrics()
+>>> print(f"first impact at {m['first_impact_time'] * 1e3:.2f} ms, {m['n_impacts']} impacts")
+first impact at 16.98 ms, 3 impacts
 """
 
 from __future__ import annotations
@@ -15,20 +30,21 @@ from typing import TYPE_CHECKING, Any
 
 #: public name -> module that defines it
 _EXPORTS: dict[str, str] = {
-    "Beam": "beam",
-    "Contactor": "beam",
-    "Support": "beam",
-    "Section": "beam",
-    "PointMass": "beam",
-    "InteriorSpring": "beam",
-    "Excitation": "loading",
-    "InitialCondition": "loading",
-    "Damping": "solver",
-    "SolverOptions": "solver",
-    "ModeSet": "modes",
-    "ScenarioModes": "modes",
-    "mode_set": "modes",
-    "scenario_modes": "modes",
+    "Beam": "model",
+    "Contactor": "model",
+    "Support": "model",
+    "Section": "model",
+    "PointMass": "model",
+    "InteriorSpring": "model",
+    "Excitation": "model",
+    "InitialCondition": "model",
+    "Damping": "model",
+    "SolverOptions": "model",
+    "ModeSet": "modal",
+    "ScenarioModes": "modal",
+    "mode_set": "modal",
+    "scenario_modes": "modal",
+    "modes": "modal",
     "simulate": "solver",
     "simulate_system": "solver",
     "SimulationResult": "result",
@@ -44,14 +60,39 @@ _EXPORTS: dict[str, str] = {
     "Scenario": "scenario",
     "load_scenario": "scenario",
     "parse_scenario": "scenario",
-    "identify": "identification",
-    "Identification": "identification",
+    "identify": "experiment",
+    "sweep": "sweeps",
+    "Identification": "experiment",
+    "periodic_orbit": "periodic.shooting",
+    "PeriodicOrbit": "periodic.shooting",
+    "ModalState": "solver",
+    "SteadyState": "periodic.strobe",
+    "steady_state": "periodic.strobe",
+    "BifurcationDiagram": "periodic.bifurcation",
+    "bifurcation": "periodic.bifurcation",
+    "bifurcation_map": "periodic.maps",
+    "FrequencyResponse": "periodic.frf",
+    "frequency_response": "periodic.frf",
+    "linear_frf": "periodic.frf",
+    "ImpactStatistics": "periodic.impact_stats",
+    "impact_statistics": "periodic.impact_stats",
 }
 
-__all__ = [*_EXPORTS, "modes", "sweep", "__version__"]
+__all__ = [*_EXPORTS, "__version__"]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
-    from .beam import Beam, Contactor, InteriorSpring, PointMass, Section, Support
+    from .model import (
+        Beam,
+        Contactor,
+        Damping,
+        Excitation,
+        InitialCondition,
+        InteriorSpring,
+        PointMass,
+        Section,
+        SolverOptions,
+        Support,
+    )
     from .exceptions import (
         ImpactBeamError,
         ImpactBeamWarning,
@@ -61,22 +102,19 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
         ScenarioError,
         SimulationError,
     )
-    from .loading import Excitation, InitialCondition
-    from .modes import ModeSet, ScenarioModes, mode_set, modes, scenario_modes
+    from .modal import ModeSet, ScenarioModes, mode_set, modes, scenario_modes
     from .result import SimulationResult, write_result
     from .scenario import Scenario, load_scenario, parse_scenario
-    from .solver import Damping, Event, SolverOptions, simulate, simulate_system
-    from .identification import Identification, identify
-    from .sweep import sweep
-
-
-# ``modes`` and ``sweep`` are both API functions and submodules: import the
-# submodules now (both are light at import) and bind the functions over them.
-from . import modes as _modes_module  # noqa: E402
-from . import sweep as _sweep_module  # noqa: E402
-
-modes = _modes_module.modes
-sweep = _sweep_module.sweep
+    from .solver import Event, simulate, simulate_system
+    from .experiment import Identification, identify
+    from .periodic.shooting import PeriodicOrbit, periodic_orbit
+    from .periodic.bifurcation import BifurcationDiagram, bifurcation
+    from .periodic.frf import FrequencyResponse, frequency_response, linear_frf
+    from .periodic.maps import bifurcation_map
+    from .periodic.impact_stats import ImpactStatistics, impact_statistics
+    from .periodic.strobe import SteadyState, steady_state
+    from .solver import ModalState
+    from .sweeps import sweep
 
 
 def __getattr__(name: str) -> Any:

@@ -1,6 +1,6 @@
 r"""Exact characteristic matrix, Wittrick-Williams count and roots of a beam state.
 
-The engine of :mod:`impactbeam.modes`. A state of the beam is cut at its nodes
+The engine of :mod:`impactbeam.modal`. A state of the beam is cut at its nodes
 (ends, section steps, interior springs, point masses, engaged contact springs)
 into ``s`` uniform segments. Segment ``j`` has ``EI_j``, ``rho A_j`` and the
 wavenumber ``beta_j = r_j beta`` with ``r_j = ((rho A_j / EI_j) / (rho A_0 /
@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._roots import brentq
-from .beam import Beam
+from .model.beam import Beam
 from .exceptions import ModeSolveError, ParameterError
 
 _MERGE_DISTANCE = 3e-5  # fraction of L
@@ -318,6 +318,14 @@ def count_below(lay_or_beam: Layout | Beam, omega: float, springs: Sequence[tupl
     """Number of natural frequencies strictly below ``omega`` [rad/s] (Wittrick-Williams).
 
     Rigid-body modes count as frequencies at zero.
+
+    Parameters
+    ----------
+    lay_or_beam : Layout or Beam
+        The beam (or its cut into segments).
+    omega : float, [rad/s]
+    springs : sequence of (position, stiffness)
+        Engaged contact springs, [m] and [N/m].
     """
     lay = lay_or_beam if isinstance(lay_or_beam, Layout) else layout(lay_or_beam, springs)
     beta = math.sqrt(omega) * (lay.rhoA / lay.EI) ** 0.25

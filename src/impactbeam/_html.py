@@ -3,7 +3,7 @@
 One small helper, :func:`table`, renders a captioned two-column table of
 (label, value) rows; :func:`sections` stacks several. The ``_repr_html_``
 methods of :class:`~impactbeam.scenario.Scenario`,
-:class:`~impactbeam.modes.ModeSet` (and of the simulation result) build
+:class:`~impactbeam.modal.ModeSet` (and of the simulation result) build
 their rows here, so every object looks the same in a notebook. All text is
 escaped.
 """
@@ -107,7 +107,7 @@ def scenario_html(sc: Any) -> str:
 
 
 def modeset_html(ms: Any, max_rows: int = 8) -> str:
-    """Summary of a :class:`~impactbeam.modes.ModeSet`: the state and its first frequencies."""
+    """Summary of a :class:`~impactbeam.modal.ModeSet`: the state and its first frequencies."""
     f = ms.frequencies_hz
     springs = ", ".join(f"{k:.4g} N/m at {mm(x)}" for x, k in ms.springs) or "none (free state)"
     rows = [("modes", f"{ms.count} ({ms.n_rigid} rigid-body)"), ("contact springs", springs)]

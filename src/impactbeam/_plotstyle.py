@@ -56,7 +56,16 @@ _EXCITATION_AXIS = {
 def figure_size(size: str | tuple[float, float] = "double", aspect: float = 0.5) -> tuple[float, float]:
     """Width and height [in] of a figure: ``"single"`` (3.5 in) or ``"double"`` column (7 in).
 
-    ``aspect`` is height / width; an explicit ``(width, height)`` passes through.
+    Parameters
+    ----------
+    size : "single", "double" or (width, height)
+        A journal column width, or an explicit size in inches (passed through).
+    aspect : float
+        Height / width for a column width.
+
+    Returns
+    -------
+    (width, height) : tuple of float, [in]
     """
     if isinstance(size, tuple):
         return size
@@ -132,6 +141,8 @@ def display_label(name: str, units: str | None) -> tuple[str, float]:
         short += f" (contactor {parts[1]})"
     elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("duration", "amplitude", "scale", "start"):
         short = f"pulse {short}"
+    elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("frequency", "phase"):
+        short = f"forcing {short}"
     elif len(parts) == 2 and parts[0] == "damping":
         short = f"damping ratio, {parts[1]} state"
     unit, scale = DISPLAY_UNITS.get(units or "", (units, 1.0))

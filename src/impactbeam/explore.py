@@ -9,22 +9,29 @@ response ``u`` at the first contactor (the quantity of the metrics), the
 contact force, and the metrics table, with the time the update took. A
 button downloads the current scenario as TOML.
 
-Panel (on the Bokeh server) is used: the figures are Bokeh plots whose data
-sources are replaced in place, so an update sends only the new arrays over
-the open websocket; with the compiled event loop a Case 3 update takes a few
-milliseconds of simulation and a few tens of milliseconds in all.
+Panel serves the page on the Bokeh server; the figures, sliders and table
+are Bokeh models updated in place (:class:`ExplorerPage`), so a change sends
+one websocket message with the new curves (decimated to about one point per
+pixel column, extrema kept), the axis ranges and the table. For the
+reference Case 3, a slider step is redrawn in the browser about 40-60 ms
+after the key press on a 2-core machine, of which the simulation and the
+sampling of the plotted curve take about 15 ms (``benchmarks/bench_explore.py``
+measures it).
 
 The model part (:class:`ExplorerModel`) has no web dependency and is what
 the tests check against :func:`impactbeam.simulate`; Panel is needed only
-by :func:`build_app` and :func:`serve` (the ``explore`` extra).
+by :class:`ExplorerPage`, :func:`build_app` and :func:`serve` (the
+``explore`` extra).
 """
 
 from __future__ import annotations
 
 import copy
+import html
 import io
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,18 +42,32 @@ from .exceptions import ParameterError
 from .metrics import METRIC_DISPLAY
 from .scenario import Scenario, parse_scenario
 
-__all__ = ["SLIDERS", "ExplorerModel", "Slider", "build_app", "serve"]
+__all__ = ["SLIDERS", "ExplorerModel", "ExplorerPage", "Slider", "build_app", "curves", "envelope", "envelope_index", "serve"]
 
 G = 9.80665  # standard gravity [m/s^2], for base accelerations shown in g
 
 
 @dataclass(frozen=True)
 class Slider:
-    """One explorer control: ``name`` (key of :attr:`ExplorerModel.values`), label, display scale."""
+    """One explorer control.
+
+    Attributes
+    ----------
+    name : str
+        Key of :attr:`ExplorerModel.values`.
+    label : str
+        Shown beside the slider, with the display unit.
+    scale : float
+        Display value = SI value * scale.
+    step : float
+        Slider step, in display units.
+    integer : bool
+        Whole numbers only (the mode count).
+    """
 
     name: str
     label: str
-    scale: float  # display value = SI value * scale
+    scale: float
     step: float
     integer: bool = False
 
@@ -115,7 +136,13 @@ class ExplorerModel:
         )
 
     def bounds(self, name: str) -> tuple[float, float]:
-        """SI range of a control around its starting value."""
+        """SI range of a control around its starting value.
+
+        Parameters
+        ----------
+        name : str
+            A key of :attr:`values`.
+        """
         x0 = self.values[name]
         if name == "gap":
             return 0.0, max(4 * x0, 1e-3)
@@ -151,7 +178,7 @@ class ExplorerModel:
         return parse_scenario(data, base_dir=self.base.base_dir, source=self.base.source, name=self.base.name)
 
     def run(self) -> dict[str, Any]:
-        """Simulate the current scenario.
+        """Simulate the current scenario and sample the plotted quantity once.
 
         Returns
         -------
@@ -160,65 +187,125 @@ class ExplorerModel:
             contactor (``-w`` above, ``w`` below) or ``w`` at the first output
             point; ``force_N``, the first contactor's force (zeros without
             one); ``metrics`` (:meth:`SimulationResult.metrics`); ``seconds``,
-            the wall time of the simulation.
+            the wall time of the simulation and its metrics; ``sample_seconds``,
+            that of sampling ``u`` and the force on the output grid.
+
+        Notes
+        -----
+        Only the one plotted point is sampled, once: the force follows from
+        the same samples (``k max(-(gap + u), 0)`` while engaged) instead of
+        the result's full output grid of every point.
         """
         from .solver import simulate
 
         sc = self.scenario()
         t0 = time.perf_counter()
         res = simulate(sc)
-        seconds = time.perf_counter() - t0
+        metrics = res.metrics()
+        t1 = time.perf_counter()
         t = np.asarray(res.time)
         if sc.contactors:
             c = sc.contactors[0]
-            sign = -1.0 if c.side == "above" else 1.0
-            x = c.position
+            samples = res.solution.sample(np.array([c.position]), t)
+            u = -c.direction * samples.w[:, 0]  # -w above, w below: the opening is gap + u
+            engaged = samples.engaged[:, 0]
+            force = np.where(engaged, c.stiffness * np.maximum(-(c.gap + u), 0.0), 0.0)
+            force[np.isnan(u)] = np.nan
         else:
-            sign, x = 1.0, sc.output_points[0]
-        u = sign * np.asarray(res.displacement([x], t)).reshape(-1)
-        force = getattr(res, "contact_force", None)
-        force = np.asarray(force)[:, 0] if force is not None and np.ndim(force) == 2 and np.shape(force)[1] else np.zeros_like(t)
-        return {"time_ms": t * 1e3, "u_mm": u * 1e3, "force_N": force, "metrics": res.metrics(), "seconds": seconds}
+            u = np.asarray(res.displacement([sc.output_points[0]], t)).reshape(-1)
+            force = np.zeros_like(t)
+        t2 = time.perf_counter()
+        return {"time_ms": t * 1e3, "u_mm": u * 1e3, "force_N": force, "metrics": metrics,
+                "seconds": t1 - t0, "sample_seconds": t2 - t1}
 
     def toml(self) -> str:
         """The current scenario as TOML text (loads back to the same scenario)."""
-        import tomli_w
-
-        from .scenario import _normalise
-
-        return tomli_w.dumps(_normalise(self.scenario().data))
+        return self.scenario().to_toml()
 
 
 # --------------------------------------------------------------------------- page
 
 
-def envelope(t: np.ndarray, y: np.ndarray, bins: int = 1500) -> tuple[np.ndarray, np.ndarray]:
-    """Decimate a curve for drawing: the first, minimum and maximum sample of each of ``bins`` buckets.
+def envelope_index(ys: list[np.ndarray], bins: int = 1000) -> np.ndarray:
+    """Indices that keep the shape of curves sampled on one grid: each bucket's first, minimum and maximum.
 
-    A screen-wide plot cannot show more than about one point per pixel
-    column; keeping each bucket's extremes keeps every peak (the impacts) that
-    plain sub-sampling would cut. Curves of up to ``3 * bins`` samples are
-    returned unchanged.
+    Parameters
+    ----------
+    ys : list of ndarray
+        Curves of the same length ``n`` on the same grid.
+    bins : int
+        Number of buckets. A screen-wide plot cannot show more than about one
+        point per pixel column; keeping each bucket's extremes keeps every
+        peak (the impacts) that plain sub-sampling would cut.
+
+    Returns
+    -------
+    ndarray of int
+        Sorted distinct indices, the first and last sample included: at most
+        ``(1 + 2 len(ys)) (bins + 1) + 1`` of them. Curves of up to
+        ``3 * bins`` samples keep every index.
     """
-    n = t.size
+    n = ys[0].size
     if n <= 3 * bins:
-        return t, y
+        return np.arange(n)
     k = n // bins  # samples per bucket; the last bucket takes the remainder
-    body = y[: k * bins].reshape(bins, k)
     starts = np.arange(bins) * k
     tail = np.arange(k * bins, n)
-    keep = [starts, starts + body.argmin(axis=1), starts + body.argmax(axis=1), tail[:1], [n - 1]]
-    if tail.size:
-        keep += [[tail[np.argmin(y[tail])]], [tail[np.argmax(y[tail])]]]
-    idx = np.unique(np.concatenate([np.asarray(i, dtype=int) for i in keep]))
+    keep = [starts, tail[:1], np.array([n - 1])]
+    for y in ys:
+        body = y[: k * bins].reshape(bins, k)
+        keep += [starts + body.argmin(axis=1), starts + body.argmax(axis=1)]
+        if tail.size:
+            keep += [tail[[np.argmin(y[tail]), np.argmax(y[tail])]]]
+    return np.unique(np.concatenate(keep))
+
+
+def envelope(t: np.ndarray, y: np.ndarray, bins: int = 1000) -> tuple[np.ndarray, np.ndarray]:
+    """Decimate one curve for drawing; see :func:`envelope_index`.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times.
+    y : ndarray
+        Values at ``t``.
+    bins : int
+        Buckets; each keeps its minimum and maximum.
+    """
+    idx = envelope_index([y], bins)
     return t[idx], y[idx]
 
 
-def _curves(out: dict[str, Any]) -> dict[str, np.ndarray]:
-    tu, u = envelope(out["time_ms"], out["u_mm"])
-    tf, f = envelope(out["time_ms"], out["force_N"])
-    return {"tu": tu, "u": u, "tf": tf, "f": f}
+def curves(out: dict[str, Any], bins: int = 1000) -> dict[str, np.ndarray]:
+    """The plotted columns of a :meth:`ExplorerModel.run` output, decimated on one shared time axis.
 
+    Parameters
+    ----------
+    out : dict
+        From :meth:`ExplorerModel.run`.
+    bins : int
+        Buckets of :func:`envelope_index`, about one per pixel column.
+
+    Returns
+    -------
+    dict
+        ``t`` [ms], ``u`` [mm] and ``f`` [N] at the samples that
+        :func:`envelope_index` keeps for either curve, as float32 (finer than
+        the page can show; half the bytes of float64 on the websocket).
+    """
+    idx = envelope_index([out["u_mm"], out["force_N"]], bins)
+    return {k: np.asarray(out[src][idx], dtype=np.float32)
+            for k, src in (("t", "time_ms"), ("u", "u_mm"), ("f", "force_N"))}
+
+
+def padded_range(y: np.ndarray, pad: float = 0.05) -> tuple[float, float]:
+    """Axis limits around the finite values of ``y`` with a margin (``(-1, 1)`` without any)."""
+    finite = y[np.isfinite(y)]
+    if not finite.size:
+        return -1.0, 1.0
+    lo, hi = float(finite.min()), float(finite.max())
+    span = hi - lo if hi > lo else max(abs(hi), 1.0)
+    return lo - pad * span, hi + pad * span
 
 
 def _fmt(value: Any, scale: float, unit: str) -> str:
@@ -237,91 +324,231 @@ def metrics_html(model: ExplorerModel, out: dict[str, Any], update_ms: float | N
 
     rows = [(label, _fmt(out["metrics"].get(key), scale, unit), f"m-{key}")
             for key, label, scale, unit in METRIC_DISPLAY]
-    rows.append(("max contact force", f"{float(np.max(out['force_N'], initial=0.0)):.4f} N", "m-max_force"))
+    rows.append(("max contact force", f"{float(np.nanmax(out['force_N'], initial=0.0)):.4f} N", "m-max_force"))
     for s in SLIDERS:
         if s.name in model.values:
             unit, scale = model.amplitude_unit() if s.name == "amplitude" else ("", s.scale)
             label = f"pulse amplitude [{unit}]" if s.name == "amplitude" else s.label
             rows.append((label, f"{model.values[s.name] * scale:.6g}", f"v-{s.name}"))
-    rows.append(("simulation", f"{out['seconds'] * 1e3:.1f} ms", "m-sim_ms"))
+    rows.append(("simulation and metrics", f"{out['seconds'] * 1e3:.1f} ms", "m-sim_ms"))
+    rows.append(("sampling", f"{out.get('sample_seconds', 0.0) * 1e3:.1f} ms", "m-sample_ms"))
     if update_ms is not None:
         rows.append(("last update (server)", f"{update_ms:.1f} ms", "m-update_ms"))
     return table(rows, caption="Metrics (u at the first contactor, positive away from it)")
 
 
-def build_app(scenario: Scenario) -> Any:
-    """The explorer page for ``scenario`` as a Panel layout (needs the ``explore`` extra)."""
-    pn = require("panel", "explore", feature="impactbeam explore")
-    plotting = require("bokeh.plotting", "explore", feature="impactbeam explore")
-    models = require("bokeh.models", "explore", feature="impactbeam explore")
+class ExplorerPage:
+    """One browser session's page: sliders, figures, metrics table and save button.
 
-    model = ExplorerModel(scenario)
-    out = model.run()
-    c = _curves(out)
-    src_u = models.ColumnDataSource({"t": c["tu"], "y": c["u"]})
-    src_f = models.ColumnDataSource({"t": c["tf"], "y": c["f"]})
-    kw = {"height": 260, "sizing_mode": "stretch_width", "tools": "pan,wheel_zoom,box_zoom,reset,save"}
-    f_u = plotting.figure(title="Response u at the first contactor", x_axis_label="time [ms]", y_axis_label="u [mm]", **kw)
-    f_u.line("t", "y", source=src_u, line_width=1.5, color="#0072B2")
-    f_f = plotting.figure(title="Contact force", x_axis_label="time [ms]", y_axis_label="force [N]", x_range=f_u.x_range, **kw)
-    f_f.line("t", "y", source=src_f, line_width=1.5, color="#D55E00", line_dash="dashed")
-    table_pane = pn.pane.HTML(metrics_html(model, out, None), css_classes=["ib-metrics"], sizing_mode="stretch_width")
-    status = pn.pane.Markdown("", css_classes=["ib-status"])
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario the page starts from.
 
-    widgets = []
-    for s in SLIDERS:
-        if s.name not in model.values:
-            continue
-        scale = model.amplitude_unit()[1] if s.name == "amplitude" else s.scale
-        label = f"pulse amplitude [{model.amplitude_unit()[0]}]" if s.name == "amplitude" else s.label
+    Attributes
+    ----------
+    model : ExplorerModel
+        The current values and their simulation.
+    source : bokeh.models.ColumnDataSource
+        The plotted columns ``t``, ``u``, ``f`` (:func:`curves`), replaced on
+        every change.
+    sliders : dict of str to bokeh.models.Slider
+        The controls by :attr:`Slider.name`.
+    table : bokeh.models.Div
+        The metrics table (:func:`metrics_html`).
+    prepared : set of tuple
+        The sets of values :meth:`prepare_modes` has run.
+    layout : panel.Row
+        The page, for :func:`panel.serve`.
+
+    Notes
+    -----
+    The controls, figures and table are Bokeh models, and a slider's
+    ``value_throttled`` (sent once per key press or at the end of a drag) is
+    watched with a Bokeh callback: it runs while the server applies the
+    change, so the update leaves before the server acknowledges the change.
+    Panel lays the page out, serves it and provides the download button; its
+    own widgets would add a 50 ms debounce and a scheduling round before the
+    callback. A change re-simulates (:meth:`ExplorerModel.run`), decimates
+    the curves once, and sends the new columns, the two y ranges (computed
+    here, so the page does not auto-range and send them back) and the table
+    in one websocket message (:func:`panel.io.unlocked`).
+    """
+
+    def __init__(self, scenario: Scenario) -> None:
+        pn = require("panel", "explore", feature="impactbeam explore")
+        plotting = require("bokeh.plotting", "explore", feature="impactbeam explore")
+        models = require("bokeh.models", "explore", feature="impactbeam explore")
+
+        self.model = ExplorerModel(scenario)
+        out = self.model.run()
+        c = curves(out)
+        self.source = models.ColumnDataSource(c)
+        t_end = float(out["time_ms"][-1])
+        self.x_range = models.Range1d(0.0, t_end, reset_start=0.0, reset_end=t_end)
+        self.u_range = models.Range1d(*padded_range(c["u"]))
+        self.f_range = models.Range1d(*padded_range(c["f"]))
+        kw = {"height": 260, "sizing_mode": "stretch_width", "tools": "pan,wheel_zoom,box_zoom,reset,save",
+              "x_range": self.x_range, "x_axis_label": "time [ms]", "min_border_left": 70}
+        f_u = plotting.figure(title="Response u at the first contactor", y_axis_label="u [mm]", y_range=self.u_range, **kw)
+        f_u.line("t", "u", source=self.source, line_width=1.5, color="#0072B2")
+        f_f = plotting.figure(title="Contact force", y_axis_label="force [N]", y_range=self.f_range, **kw)
+        f_f.line("t", "f", source=self.source, line_width=1.5, color="#D55E00", line_dash="dashed")
+        self.table = models.Div(text=metrics_html(self.model, out, None), css_classes=["ib-metrics"],
+                                sizing_mode="stretch_width")
+        self.status = models.Div(text="", css_classes=["ib-status"], width=300)
+        self.sliders = {s.name: self._slider(models, s) for s in SLIDERS if s.name in self.model.values}
+        self.prepared: set[tuple[Any, ...]] = set()  # mode counts prepared by prepare_modes
+        style = "color" if "color" in pn.widgets.FileDownload.param else "button_type"  # renamed in Panel 1.9
+        save = pn.widgets.FileDownload(
+            callback=lambda: io.BytesIO(self.model.toml().encode()),
+            filename=f"{scenario.name}-explored.toml",
+            label="Save scenario as TOML",
+            css_classes=["ib-save"],
+            **{style: "primary"},
+        )
+        title = f"## impactbeam explorer: {scenario.description or scenario.name}"
+        controls = pn.Column(*self.sliders.values(), save, self.status, width=320)
+        self.layout = pn.Row(controls, pn.Column(pn.pane.Markdown(title), f_u, f_f, self.table,
+                                                 sizing_mode="stretch_width"),
+                             sizing_mode="stretch_width")
+
+    def _slider(self, models: Any, s: Slider) -> Any:
+        """The Bokeh slider of one control, in display units, watching ``value_throttled``."""
+        model = self.model
+        unit, scale = model.amplitude_unit() if s.name == "amplitude" else ("", s.scale)
+        label = f"pulse amplitude [{unit}]" if s.name == "amplitude" else s.label
         lo, hi = model.bounds(s.name)
         if s.integer:
-            w = pn.widgets.IntSlider(name=label, start=int(lo), end=int(hi), value=int(model.values[s.name]), step=1)
+            w = models.Slider(title=label, start=int(lo), end=int(hi), value=int(model.values[s.name]), step=1,
+                              format="0")
         else:
             step = s.step if s.name != "amplitude" else max(abs(model.values[s.name] * scale) / 100, 1e-6)
             decimals = max(0, -math.floor(math.log10(step)))
-            w = pn.widgets.FloatSlider(
-                name=label, start=lo * scale, end=hi * scale, value=model.values[s.name] * scale, step=step,
-                format="0" + ("." + "0" * decimals if decimals else ""),
-            )
+            w = models.Slider(title=label, start=lo * scale, end=hi * scale, value=model.values[s.name] * scale,
+                              step=step, format="0" + ("." + "0" * decimals if decimals else ""))
         w.css_classes = [f"ib-{s.name}"]
+        w.sizing_mode = "stretch_width"
+        w.on_change("value_throttled", lambda attr, old, new: self.set_value(s.name, new))
+        return w
 
-        def on_change(event: Any, s: Slider = s, scale: float = scale) -> None:
-            t0 = time.perf_counter()
-            old = model.values[s.name]
-            model.values[s.name] = int(event.new) if s.integer else float(event.new) / scale
-            try:
-                new = model.run()
-            except ParameterError as exc:
-                model.values[s.name] = old
-                status.object = f"**Not applied:** {exc}"
-                return
-            c = _curves(new)
-            src_u.data = {"t": c["tu"], "y": c["u"]}
-            src_f.data = {"t": c["tf"], "y": c["f"]}
-            table_pane.object = metrics_html(model, new, (time.perf_counter() - t0) * 1e3)
-            status.object = ""
+    def set_value(self, name: str, shown: float) -> bool:
+        """Apply a control's new value (in display units): re-simulate and redraw.
 
-        w.param.watch(on_change, "value_throttled")
-        widgets.append(w)
+        Parameters
+        ----------
+        name : str
+            The control (:attr:`Slider.name`).
+        shown : float
+            Its value as the slider shows it (mm, ms, g, %, ...).
 
-    save = pn.widgets.FileDownload(
-        callback=lambda: io.BytesIO(model.toml().encode()),
-        filename=f"{scenario.name}-explored.toml",
-        label="Save scenario as TOML",
-        button_type="primary",
-        css_classes=["ib-save"],
-    )
-    title = f"## impactbeam explorer: {scenario.description or scenario.name}"
-    controls = pn.Column(*widgets, save, status, width=320)
-    return pn.Row(controls, pn.Column(pn.pane.Markdown(title), pn.pane.Bokeh(f_u), pn.pane.Bokeh(f_f), table_pane,
-                                      sizing_mode="stretch_width"), sizing_mode="stretch_width")
+        Returns
+        -------
+        bool
+            False when the scenario rejects the value: the old one is kept and
+            the reason is shown under the sliders.
+        """
+        from panel.io import unlocked
+
+        t0 = time.perf_counter()
+        s = next(x for x in SLIDERS if x.name == name)
+        scale = self.model.amplitude_unit()[1] if name == "amplitude" else s.scale
+        old = self.model.values[name]
+        self.model.values[name] = int(shown) if s.integer else float(shown) / scale
+        try:
+            out = self.model.run()
+        except ParameterError as exc:
+            self.model.values[name] = old
+            self.status.text = f"<b>Not applied:</b> {html.escape(str(exc))}"
+            self.sliders[name].value = int(old) if s.integer else old * scale  # back to the value in force
+            return False
+        c = curves(out)
+        u_lo, u_hi = padded_range(c["u"])
+        f_lo, f_hi = padded_range(c["f"])
+        with unlocked():  # one message for the whole change
+            self.source.data = c
+            self.u_range.update(start=u_lo, end=u_hi, reset_start=u_lo, reset_end=u_hi)
+            self.f_range.update(start=f_lo, end=f_hi, reset_start=f_lo, reset_end=f_hi)
+            self.table.text = metrics_html(self.model, out, (time.perf_counter() - t0) * 1e3)
+            if self.status.text:
+                self.status.text = ""
+        if name == "modes":
+            self._schedule_neighbours()
+        return True
+
+    def _schedule_neighbours(self) -> None:
+        """Prepare the mode counts one step away, each in its own later tick of the server."""
+        doc = self.table.document
+        if doc is None or doc.session_context is None:
+            return
+        n = int(self.model.values["modes"])
+        lo, hi = self.model.bounds("modes")
+        for count in (n + 1, n - 1):
+            if lo <= count <= hi:
+                doc.add_timeout_callback(lambda count=count: self.prepare_modes(count), 0)
+
+    def prepare_modes(self, count: int) -> bool:
+        """Run the current scenario with ``count`` modes once, so that its mode sets are cached.
+
+        The first run at a new number of modes computes the modes of every
+        contact state (about 35 ms at 30 modes, against 2 ms for a run that
+        finds them cached); the page does it for the counts next to the
+        current one after each change of the modes slider, between the
+        user's changes, so that stepping through the counts finds them ready.
+
+        Parameters
+        ----------
+        count : int
+            Number of modes per state.
+
+        Returns
+        -------
+        bool
+            True if it ran, False if these modes were prepared already or the
+            scenario rejects them.
+        """
+        from .solver import simulate
+
+        values = dict(self.model.values, modes=int(count))
+        key = tuple(sorted(values.items()))
+        if key in self.prepared:
+            return False
+        self.prepared.add(key)
+        probe = ExplorerModel(self.model.base)
+        probe.values = values
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # the run the user asks for reports them
+                simulate(probe.scenario())
+        except ParameterError:
+            return False
+        return True
+
+
+def build_app(scenario: Scenario) -> Any:
+    """The explorer page for ``scenario`` as a Panel layout (needs the ``explore`` extra).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The starting point of the sliders.
+    """
+    return ExplorerPage(scenario).layout
 
 
 def serve(scenario: Scenario, *, port: int = 5006, show: bool = False) -> Any:
     """Serve the explorer on ``http://127.0.0.1:port`` until interrupted (blocks).
 
     Each browser session gets its own page built by :func:`build_app`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The starting point of the sliders.
+    port : int
+        Port on 127.0.0.1 (0: any free port).
+    show : bool
+        Open a browser.
     """
     pn = require("panel", "explore", feature="impactbeam explore")
     if not (0 <= int(port) <= 65535):

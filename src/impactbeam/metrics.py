@@ -25,14 +25,16 @@ Per impact (``impacts``): contactor, start, end, duration, peak force and impuls
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from .result import SimulationResult
+    from ._typing import ResultLike
+    from .model.beam import Contactor
 
-__all__ = ["compute_metrics", "contact_intervals", "METRIC_UNITS", "METRIC_DISPLAY"]
+__all__ = ["compute_metrics", "contact_intervals", "response_point", "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
 METRIC_UNITS = {
@@ -59,11 +61,25 @@ METRIC_DISPLAY = (
     ("first_impact_time", "first impact", 1e3, "ms"),
     ("n_impacts", "impacts", 1.0, ""),
     ("max_penetration", "max penetration", 1e3, "mm"),
+    ("max_bending_stress", "max bending stress", 1e-6, "MPa"),
+    ("max_bending_stress_time", "at time", 1e3, "ms"),
+    ("max_bending_stress_position", "at x", 1e3, "mm"),
 )
 
 
-def contact_intervals(result: SimulationResult, contactor: int = 0) -> list[tuple[float, float]]:
-    """Contact intervals ``(start, end)`` of one contactor; ``end`` is inf if still engaged."""
+def contact_intervals(result: ResultLike, contactor: int = 0) -> list[tuple[float, float]]:
+    """Contact intervals ``(start, end)`` of one contactor; ``end`` is inf if still engaged.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    contactor : int
+        Index of the contactor.
+
+    Returns
+    -------
+    list of (float, float), [s]
+    """
     out: list[tuple[float, float]] = []
     start: float | None = None
     for ev in result.events:
@@ -79,15 +95,37 @@ def contact_intervals(result: SimulationResult, contactor: int = 0) -> list[tupl
     return out
 
 
-def _metric_point(result: SimulationResult) -> tuple[float, float]:
+def response_point(contactors: Sequence[Contactor], points: Sequence[float]) -> tuple[float, float]:
+    """Where the metrics read the response, and the sign of ``u = sign * w`` there.
+
+    The one rule for ``u`` (module docstring): at the first contactor,
+    ``u = -s w`` with ``s`` its :attr:`~impactbeam.model.beam.Contactor.direction`
+    (positive away from it); without contactors ``u = w`` at the first output point.
+
+    Parameters
+    ----------
+    contactors : sequence of Contactor
+    points : sequence of float, [m]
+        The output points.
+
+    Returns
+    -------
+    x : float, [m]
+    sign : float
+        +1 or -1.
+    """
+    if contactors:
+        c0 = contactors[0]
+        return c0.position, -c0.direction
+    return float(points[0]), 1.0
+
+
+def _metric_point(result: ResultLike) -> tuple[float, float]:
     """Position of the metrics and the sign making ``u`` positive away from the contactor."""
-    if result.contactors:
-        c0 = result.contactors[0]
-        return c0.position, (-1.0 if c0.side == "above" else 1.0)
-    return float(result.points[0]), 1.0
+    return response_point(result.contactors, result.points)
 
 
-def compute_metrics(result: SimulationResult, *, impacts: bool = True) -> dict[str, Any]:
+def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, Any]:
     """The metrics dictionary of :meth:`SimulationResult.metrics`.
 
     All extrema of one call are found in one batch of the compiled kernel
@@ -95,6 +133,18 @@ def compute_metrics(result: SimulationResult, *, impacts: bool = True) -> dict[s
     per-impact table, the minimum of ``u`` in a contact interval of the first
     contactor is read from that interval's peak compression
     (``u = -s w(a)`` there, so ``min u = -(peak compression + gap)``).
+
+    Parameters
+    ----------
+    result : SimulationResult
+    impacts : bool
+        Include the per-impact table (``"impacts"``).
+
+    Returns
+    -------
+    dict
+        Keys of :data:`METRIC_UNITS` (SI values, None where undefined), the
+        events and, with ``impacts``, the per-impact table.
     """
     sol = result.solution
     x, sign = _metric_point(result)
@@ -104,13 +154,15 @@ def compute_metrics(result: SimulationResult, *, impacts: bool = True) -> dict[s
     out["n_events"] = len(result.events)
     rows = _contact_rows(result) if impacts else []
     queries: list[tuple] = [(x, 0.0, t_end, sign, 0.0, None)]
-    if result.contactors:
+    if not result.contactors:
+        queries.append((x, 0.0, t_end, -sign, 0.0, None))
+    elif not impacts:  # with the table, the largest compression is the largest of its peaks
         c0 = result.contactors[0]
         queries.append((c0.position, 0.0, t_end, c0.direction, -c0.direction * c0.gap, 0))
-    else:
-        queries.append((x, 0.0, t_end, -sign, 0.0, None))
+    first_peak = len(queries)
     queries += [_peak_query(result, ci, a, be) for ci, a, _, be in rows]
     ext = sol.extrema(queries)
+    peaks = ext[first_peak:, 0]
     if not np.isfinite(ext[0, 0]):
         if impacts:
             out["impacts"] = []
@@ -122,14 +174,15 @@ def compute_metrics(result: SimulationResult, *, impacts: bool = True) -> dict[s
     if not result.contactors:
         out["min_response"] = -float(ext[1, 0])
     else:
-        out["max_penetration"] = max(float(ext[1, 0]), 0.0) if np.isfinite(ext[1, 0]) else 0.0
-        _contact_metrics(result, out, t_max, rows, ext[2:, 0])
+        deepest = ext[1, 0] if not impacts else max((p for (ci, *_), p in zip(rows, peaks) if ci == 0), default=-np.inf)
+        out["max_penetration"] = max(float(deepest), 0.0) if np.isfinite(deepest) else 0.0
+        _contact_metrics(result, out, t_max, rows, peaks)
     if impacts:
-        out["impacts"] = _impact_table(result, rows, ext[2:, 0])
+        out["impacts"] = _impact_table(result, rows, peaks)
     return out
 
 
-def _contact_metrics(result: SimulationResult, out: dict[str, Any], t_max: float, rows: list, peaks) -> None:
+def _contact_metrics(result: ResultLike, out: dict[str, Any], t_max: float, rows: list, peaks) -> None:
     """Impact count, first impact, free and contact durations and the minimum in contact."""
     sol = result.solution
     c0 = result.contactors[0]
@@ -161,7 +214,7 @@ def _contact_metrics(result: SimulationResult, out: dict[str, Any], t_max: float
         out["min_response"] = -(peak + c0.gap)
 
 
-def _contact_rows(result: SimulationResult) -> list[tuple[int, float, float, float]]:
+def _contact_rows(result: ResultLike) -> list[tuple[int, float, float, float]]:
     """(contactor, start, end, end clipped to the solution) of every contact interval."""
     t_end = result.solution.t_end
     rows = []
@@ -172,13 +225,13 @@ def _contact_rows(result: SimulationResult) -> list[tuple[int, float, float, flo
     return rows
 
 
-def _peak_query(result: SimulationResult, ci: int, a: float, be: float) -> tuple:
+def _peak_query(result: ResultLike, ci: int, a: float, be: float) -> tuple:
     """Extremum query for the largest compression ``s w(a) - gap`` of contactor ``ci`` on ``[a, be]``."""
     c = result.contactors[ci]
     return (c.position, a, be, c.direction, -c.direction * c.gap, ci)
 
 
-def _impact_table(result: SimulationResult, rows: list, peaks) -> list[dict[str, Any]]:
+def _impact_table(result: ResultLike, rows: list, peaks) -> list[dict[str, Any]]:
     """Duration, peak force and impulse of every contact interval (exact, closed form).
 
     The compression of contactor ``c`` is ``-g = s w(a) - gap``; the peak force

@@ -8,12 +8,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .plot import _MM, PlotHandles, _finish, _new_figure
+from ._figure import PlotHandles, _finish, _new_figure
+
+_MM = 1e3
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from .modes import ModeSet
+    from .modal import ModeSet
 
 __all__ = ["plot_modes"]
 
@@ -43,6 +45,17 @@ def plot_modes(
         How many modes to draw (the first ones); None: all.
     contactors : sequence of Contactor
         Contactors of the scenario (drawn at their positions).
+    ax : matplotlib Axes, optional
+        Draw here instead of on a new figure.
+    title : str, optional
+    path : str or path-like, optional
+        Also save the figure there (:func:`impactbeam.plot.save_figure`).
+    dpi : int
+        Resolution of raster formats.
+
+    Returns
+    -------
+    PlotHandles
     """
     if ax is None:
         fig, grid = _new_figure((7.5, 4.0))

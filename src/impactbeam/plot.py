@@ -25,25 +25,20 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from ._atomic import atomic_path
-from ._optional import require
+from ._figure import PlotHandles, _finish, _new_figure, save_figure
 from ._plotstyle import (
     _EXCITATION_AXIS,
     SERIES_STYLES,
     STYLE,
-    _log_ticks,
     _outside_legend,
     _response_label,
     rc_context,
     _side_legend,
-    _wrap,
     _style,
     _styled,
     figure_size,
@@ -52,10 +47,8 @@ from .exceptions import ParameterError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
-    from matplotlib.figure import Figure
 
-    from .modes import ModeSet
-    from .result import SimulationResult
+    from ._typing import ResultLike
 
 __all__ = [
     "PlotHandles",
@@ -72,92 +65,11 @@ __all__ = [
     "rc_context",
 ]
 
-#: Image formats :func:`save_figure` accepts (by file suffix).
-FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
-
 _MM = 1e3
 _MS = 1e3
 
 
-@dataclass(frozen=True)
-class PlotHandles:
-    """What a plotting function drew.
-
-    Attributes
-    ----------
-    figure : matplotlib.figure.Figure
-    axes : tuple of Axes
-        Every axes drawn on, main axes first.
-    lines : tuple of Line2D
-        The data lines, in drawing order.
-    artists : dict
-        Other named artists (``"contact_spans"``, ``"impacts"``, ``"legend"`` ...).
-    """
-
-    figure: Figure
-    axes: tuple[Axes, ...]
-    lines: tuple[Any, ...]
-    artists: dict[str, Any] = field(default_factory=dict)
-
-    def __repr__(self) -> str:
-        return f"<PlotHandles: figure with {len(self.axes)} axes, {len(self.lines)} lines>"
-
-    def _repr_mimebundle_(self, include: Any = None, exclude: Any = None) -> dict[str, Any]:
-        """Jupyter shows the figure (PNG), not a text dump."""
-        import io
-
-        buf = io.BytesIO()
-        self.figure.savefig(buf, format="png", dpi=150)
-        return {"image/png": buf.getvalue(), "text/plain": repr(self)}
-
-    def save(self, path: str | os.PathLike[str], *, dpi: int = 300) -> Path:
-        """Write the figure to ``path`` (format from the suffix); see :func:`save_figure`."""
-        return save_figure(self.figure, path, dpi=dpi)
-
-
-# --------------------------------------------------------------------------- helpers
-
-
-def _new_figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
-    """A figure on the Agg canvas, independent of pyplot's global state."""
-    FigureCanvasAgg = require("matplotlib.backends.backend_agg", "plot").FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
-    return fig, axes
-
-
-def save_figure(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 300) -> Path:
-    """Write ``figure`` to ``path`` atomically (temporary file + :func:`os.replace`).
-
-    ``dpi`` applies to raster formats; ``.pdf``, ``.svg`` and ``.eps`` are vector.
-
-    Raises
-    ------
-    ParameterError
-        The suffix is not an image format matplotlib writes.
-    OSError
-        The directory does not exist or is not writable.
-    """
-    p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix not in FIGURE_SUFFIXES:
-        raise ParameterError(f'figure path: unsupported file type "{p.suffix or p.name}" (use {", ".join(FIGURE_SUFFIXES)})')
-    with atomic_path(p) as tmp:
-        meta = {".png": {"Software": None}, ".pdf": {"CreationDate": None}, ".svg": {"Date": None}}.get(suffix)
-        figure.savefig(tmp, format=suffix.lstrip("."), dpi=dpi, metadata=meta)
-    return p
-
-
-def _finish(handles: PlotHandles, path: str | os.PathLike[str] | None, dpi: int = 300) -> PlotHandles:
-    if path is not None:
-        save_figure(handles.figure, path, dpi=dpi)
-    return handles
-
-
-def _contact_point(result: SimulationResult) -> tuple[float, np.ndarray, str]:
+def _contact_point(result: ResultLike) -> tuple[float, np.ndarray, str]:
     """Position, sampled w and a label of the first contactor, else the first output point."""
     if len(result.contactors):
         c = result.contactors[0]
@@ -165,7 +77,7 @@ def _contact_point(result: SimulationResult) -> tuple[float, np.ndarray, str]:
     return float(result.points[0]), np.asarray(result.w[:, 0]), "first output point"
 
 
-def _w_at(result: SimulationResult, x: float | None) -> tuple[float, np.ndarray]:
+def _w_at(result: ResultLike, x: float | None) -> tuple[float, np.ndarray]:
     """Sampled deflection at ``x`` (exact dense output when x is not an output point)."""
     if x is None:
         x0, w, _ = _contact_point(result)
@@ -181,7 +93,7 @@ def _w_at(result: SimulationResult, x: float | None) -> tuple[float, np.ndarray]
 
 
 def surface_distance(
-    result: SimulationResult, *, x: float | None = None, side: Literal["above", "below"] = "above"
+    result: ResultLike, *, x: float | None = None, side: Literal["above", "below"] = "above"
 ) -> np.ndarray:
     """The paper's plotted deflection: distance from the contactor surface [m], positive away.
 
@@ -191,6 +103,19 @@ def surface_distance(
     negative values mean contact, as in Figs. 4-8 of Xu & Ervin (2013).
     Without a contactor it is ``-s w(x, t)`` at ``x`` (default the first
     output point), oriented as if a contactor were on ``side`` with no gap.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    x : float, optional, [m]
+        Where to read ``w`` without a contactor.
+    side : {"above", "below"}
+        Orientation without a contactor.
+
+    Returns
+    -------
+    ndarray, (n_t,), [m]
+        At the result's output times.
     """
     if len(result.contactors):
         c = result.contactors[0]
@@ -222,7 +147,7 @@ def _draw_excitation(ax: Axes, excitation: Any, t: np.ndarray, compact: bool = F
 
 @_styled
 def plot_result(
-    result: SimulationResult,
+    result: ResultLike,
     path: str | os.PathLike[str] | None = None,
     *,
     ax: Axes | None = None,
@@ -347,7 +272,7 @@ def plot_result(
 
 @_styled
 def plot_response(
-    results: SimulationResult | Sequence[SimulationResult],
+    results: ResultLike | Sequence[ResultLike],
     *,
     ax: Axes | None = None,
     labels: Sequence[str] | None = None,
@@ -471,130 +396,4 @@ def plot_excitation(
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
 
 
-# --------------------------------------------------------------------------- studies
-
-
-@_styled
-def plot_parameter_study(
-    values: Sequence[float] | np.ndarray,
-    metrics: Mapping[str, Sequence[float] | np.ndarray],
-    *,
-    axes: Sequence[Axes] | None = None,
-    parameter_label: str = "parameter",
-    metric_labels: Mapping[str, str] | None = None,
-    baseline: float | None = None,
-    xscale: Literal["linear", "log"] = "linear",
-    title: str | None = None,
-    size: str | tuple[float, float] = "double",
-    path: str | os.PathLike[str] | None = None,
-    dpi: int = 300,
-) -> PlotHandles:
-    """One panel per metric against one varied parameter (one-at-a-time study).
-
-    Parameters
-    ----------
-    values : array_like, (n,)
-        Parameter values, already in the unit named by ``parameter_label``.
-    metrics : mapping of name -> array_like (n,)
-        Metric values, already in display units (NaN points are left out).
-    axes : sequence of Axes, optional
-        One per metric; default a grid of 2 columns.
-    parameter_label : str
-        x-axis label with unit.
-    metric_labels : mapping of name -> str, optional
-        y-axis labels with units (default: the names).
-    baseline : float, optional
-        Marks the reference value with a vertical dotted line.
-    xscale : {"linear", "log"}
-        On a log axis only the decades and 2, 5 times them are labelled.
-    title : str, optional
-    size : {"single", "double"} or (width, height)
-    path : path-like, optional
-    dpi : int
-    """
-    names = list(metrics)
-    if not names:
-        raise ParameterError("metrics: at least one metric is needed")
-    xv = np.asarray(values, dtype=float)
-    if axes is None:
-        ncols = 2 if len(names) > 1 else 1
-        nrows = math.ceil(len(names) / ncols)
-        width = figure_size(size)[0]
-        fig, grid = _new_figure((width, (0.3 if ncols == 2 else 0.55) * width * nrows + 0.3), nrows, ncols)
-        axes = list(grid.ravel())
-        for extra in axes[len(names):]:
-            extra.set_visible(False)
-        axes = axes[: len(names)]
-    else:
-        axes = list(axes)
-        if len(axes) < len(names):
-            raise ParameterError(f"axes: {len(axes)} axes for {len(names)} metrics")
-        fig = axes[0].figure
-    labels = dict(metric_labels or {})
-    lines = []
-    for a, name in zip(axes, names):
-        y = np.asarray(metrics[name], dtype=float)
-        if y.shape != xv.shape:
-            raise ParameterError(f"metrics.{name}: {y.size} values for {xv.size} parameter values")
-        ok = np.isfinite(y)
-        lines.extend(a.plot(xv[ok], y[ok], marker="o", ms=3, lw=1.0, color="#000000"))
-        if baseline is not None:
-            a.axvline(baseline, color="0.45", ls=":", lw=0.9)
-        a.set_xscale(xscale)
-        if ok.any() and np.all(y[ok] == np.round(y[ok])):  # counts: integer ticks
-            a.yaxis.set_major_locator(require("matplotlib.ticker", "plot").MaxNLocator(integer=True))
-        if xscale == "log":
-            _log_ticks(a.xaxis)
-        a.set_xlabel(_wrap(parameter_label) if len(axes) > 1 else parameter_label)
-        a.set_ylabel(labels.get(name, name))
-        a.grid(True, alpha=0.3)
-    if title:
-        fig.suptitle(title)
-    return _finish(PlotHandles(fig, tuple(axes), tuple(lines)), path, dpi)
-
-
-@_styled
-def plot_convergence(
-    modes: Sequence[int],
-    series: Mapping[str, Sequence[float] | np.ndarray],
-    *,
-    ax: Axes | None = None,
-    reference_index: int = -1,
-    title: str | None = None,
-    size: str | tuple[float, float] = "single",
-    path: str | os.PathLike[str] | None = None,
-    dpi: int = 300,
-) -> PlotHandles:
-    """Relative change of metrics against the number of modes (log scale).
-
-    Each series is drawn as ``|v_N - v_ref| / |v_ref|`` in percent, ``v_ref``
-    its value at ``reference_index`` (default: the most modes). The reference
-    point itself (zero) is not drawn on the log axis.
-    """
-    own = ax is None
-    if own:
-        fig, grid = _new_figure(figure_size(size, 0.8))
-        ax = grid[0, 0]
-    else:
-        fig = ax.figure
-    n = np.asarray(modes, dtype=float)
-    lines = []
-    for i, (name, vals) in enumerate(series.items()):
-        v = np.asarray(vals, dtype=float)
-        ref = v[reference_index]
-        rel = np.abs(v - ref) / abs(ref) * 100.0 if ref != 0 else np.full_like(v, np.nan)
-        ok = np.isfinite(rel) & (rel > 0)
-        color, ls, marker = SERIES_STYLES[i % len(SERIES_STYLES)]
-        lines.extend(ax.plot(n[ok], rel[ok], marker=marker, ms=3.5, color=color, ls=ls, label=name))
-    ax.set_xscale("log", base=2)
-    ax.set_yscale("log")
-    _log_ticks(ax.yaxis)
-    ax.set_xticks(n, [str(int(k)) for k in n])
-    ax.xaxis.set_minor_locator(require("matplotlib.ticker", "plot").NullLocator())
-    ax.set_xlabel("modes per state N [-]")
-    ax.set_ylabel(f"change from N = {int(n[reference_index])} [%]")
-    ax.grid(True, which="both", alpha=0.3)
-    if title:
-        ax.set_title(title)
-    leg = _outside_legend(fig, ax, ncols=1) if own else _side_legend(ax)
-    return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
+from .studyplot import plot_convergence, plot_parameter_study  # noqa: E402  (re-exported: part of this module's API)

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import functools
-import json
-import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,89 +11,22 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import atomic_path
-from .beam import Beam, Contactor
-from .exceptions import ParameterError, ResourceError
+from ._io import RESULT_SUFFIXES, atomic_path
+from ._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
+from .model.beam import Beam, Contactor
+from .exceptions import ParameterError
 
 if TYPE_CHECKING:
     import xarray as xr
 
-    from .solver.solution import Event, PiecewiseSolution
+    from .solver.solution import Event, ModalState, PiecewiseSolution
 
 __all__ = [
-    "SimulationResult", "write_result", "RESULT_SUFFIXES", "memory_limit", "check_memory", "output_bytes",
+    "SimulationResult", "write_result", "RESULT_SUFFIXES", "sample_count", "memory_limit", "check_memory", "output_bytes",
     "check_output_size",
 ]
 
-RESULT_SUFFIXES = (".nc", ".csv", ".parquet")
 _CHUNK = 65536  # samples evaluated per call of the compiled sampler
-_REFERENCE = (
-    "W. Xu and E. K. Ervin, Parameters affecting the transient response of an impacting beam, "
-    "Shock and Vibration 20 (2013)"
-)
-
-
-def memory_limit() -> int:
-    """Bytes a request may allocate for sampled histories.
-
-    The smallest of: ``IMPACTBEAM_MEMORY_LIMIT`` (bytes, or a number with a
-    ``K``, ``M`` or ``G`` suffix; default 4 GiB), half of the machine's
-    physical memory, and 80 % of the process's address-space limit
-    (``ulimit -v``) when one is set.
-    """
-    raw = os.environ.get("IMPACTBEAM_MEMORY_LIMIT", "").strip().upper()
-    limit = 4 << 30
-    if raw:
-        mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
-        try:
-            limit = int(float(raw.rstrip("KMGB") or "nan") * mult)
-        except ValueError:
-            raise ParameterError(f"IMPACTBEAM_MEMORY_LIMIT: not a size: {raw!r}") from None
-    try:
-        limit = min(limit, os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2)
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
-        pass
-    try:
-        import resource
-
-        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
-        if soft != resource.RLIM_INFINITY:
-            limit = min(limit, int(0.8 * soft))
-    except (ImportError, OSError, ValueError):  # pragma: no cover - not POSIX
-        pass
-    return limit
-
-
-def check_memory(nbytes: float, what: str, hint: str) -> None:
-    """Raise ResourceError before allocating more than :func:`memory_limit`."""
-    limit = memory_limit()
-    if nbytes > limit:
-        raise ResourceError(
-            f"{what} would need {nbytes / 2**30:.3g} GiB, above the limit of {limit / 2**30:.3g} GiB; {hint} "
-            "(or raise IMPACTBEAM_MEMORY_LIMIT)"
-        )
-
-
-def output_bytes(n_times: int, n_points: int, n_contactors: int, n_modes: int, *, modal: bool = True) -> int:
-    """Estimated peak bytes of the sampled histories of a result and one copy of them.
-
-    ``w, w_t`` at the points and the contactors, contact forces and states,
-    and, with ``modal``, the modal coordinates and the seven energy series; the
-    factor 2 covers the copy a Dataset or DataFrame makes.
-    """
-    per = 8 * (2 * (n_points + n_contactors) + 2 * n_contactors) + n_contactors
-    if modal:
-        per += 8 * (2 * n_modes + 4 + 7)
-    return 2 * per * n_times
-
-
-def check_output_size(n_times: int, n_points: int, n_contactors: int, n_modes: int, modal: bool = True) -> None:
-    """Raise ResourceError, before any work, when :func:`output_bytes` exceeds :func:`memory_limit`."""
-    check_memory(
-        output_bytes(n_times, n_points, n_contactors, n_modes, modal=modal),
-        f"sampling {n_times} output times at {n_points} points" + (f" with {n_modes} modal coordinates" if modal else ""),
-        "use a larger solver.time_step, fewer output points or a shorter end_time",
-    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +46,21 @@ class SimulationResult:
         Output times (multiples of ``solver.time_step``).
     points : ndarray, (n_p,), [m]
         Output positions.
+    beam : Beam
+    contactors : tuple of Contactor
+    n_modes : int
+        Modes per state used.
+    time_step, end_time : float, [s]
+        Output step and end of the run (``solver.time_step``, ``solver.end_time``).
+    scenario_name : str
+    options : dict
+        The solver options of the run (stored in result files).
+    rerun : callable, optional
+        ``rerun(n_modes)`` repeats the run with another mode count (for :attr:`convergence`).
+    tolerance : float
+        Relative change above which the result is flagged as not converged.
+    scenario : Scenario, optional
+        The scenario of the run (its TOML text goes into result files).
     w, w_t : ndarray, (n_t, n_p), [m], [m/s]
         Deflection and velocity at the output points (exact at the samples).
     w_contact, w_t_contact : ndarray, (n_t, n_c)
@@ -185,7 +131,13 @@ class SimulationResult:
 
     # ------------------------------------------------------------------ convergence in the modes
     def set_convergence(self, changes: dict[str, float]) -> None:
-        """Record the relative change of the metrics against a smaller mode count."""
+        """Record the relative change of the metrics against a smaller mode count.
+
+        Parameters
+        ----------
+        changes : dict of str -> float
+            Metric name -> relative change (see :attr:`convergence`).
+        """
         self.__dict__["_convergence"] = dict(changes)
 
     @property
@@ -247,8 +199,7 @@ class SimulationResult:
     # ------------------------------------------------------------------ sampled histories (lazy)
     @functools.cached_property
     def time(self) -> np.ndarray:
-        n = int(math.floor(self.end_time / self.time_step * (1.0 + 1e-12))) + 1
-        return np.arange(n) * self.time_step
+        return np.arange(sample_count(self.end_time, self.time_step)) * self.time_step
 
     def _sampled(self, modal: bool) -> dict[str, np.ndarray]:
         t = self.time
@@ -345,7 +296,17 @@ class SimulationResult:
         }
 
     # ------------------------------------------------------------------ dense output
-    def _check_points(self, x: Any) -> np.ndarray:
+    def check_points(self, x: Any) -> np.ndarray:
+        """Positions as a float array; ParameterError for a point off the beam.
+
+        Parameters
+        ----------
+        x : float or array_like, [m]
+
+        Returns
+        -------
+        ndarray, [m]
+        """
         x = np.atleast_1d(np.asarray(x, dtype=float))
         L = self.beam.length
         bad = ~np.isfinite(x) | (x < 0.0) | (x > L * (1.0 + 1e-12))
@@ -356,18 +317,100 @@ class SimulationResult:
     def displacement(self, x: Any, t: Any) -> np.ndarray:
         """Exact deflection ``w(x, t)`` [m] at any positions and times: array (n_x, n_t).
 
-        Raises ParameterError for a point off the beam or a time outside
-        ``[0, end_time]``; times after a chattering stop give NaN.
+        Parameters
+        ----------
+        x : float or array_like, [m]
+            Positions on the beam.
+        t : float or array_like, [s]
+            Times in ``[0, end_time]``.
+
+        Returns
+        -------
+        ndarray, (n_x, n_t), [m]
+            Times after a chattering stop give NaN.
+
+        Raises
+        ------
+        ParameterError
+            A point off the beam or a time outside ``[0, end_time]``.
         """
-        x = self._check_points(x)
+        x = self.check_points(x)
         t = self.solution.check_times(t, self.end_time)
         return self.solution.sample(x, t).w.T
 
     def velocity(self, x: Any, t: Any) -> np.ndarray:
-        """Exact velocity ``w_t(x, t)`` [m/s]: array (n_x, n_t); see :meth:`displacement`."""
-        x = self._check_points(x)
+        """Exact velocity ``w_t(x, t)`` [m/s]: array (n_x, n_t).
+
+        Parameters
+        ----------
+        x : float or array_like, [m]
+            Positions on the beam.
+        t : float or array_like, [s]
+            Times in ``[0, end_time]``.
+
+        Returns
+        -------
+        ndarray, (n_x, n_t), [m/s]
+            See :meth:`displacement` for NaN and errors.
+        """
+        x = self.check_points(x)
         t = self.solution.check_times(t, self.end_time)
         return self.solution.sample(x, t).w_t.T
+
+    def bending_moment(self, points: Any, times: Any, *, static_correction: bool = True) -> np.ndarray:
+        """Bending moment ``EI w''`` [N m] at any positions and times: array (n_x, n_t).
+
+        Parameters
+        ----------
+        points : float or array_like, [m]
+            Positions on the beam.
+        times : float or array_like, [s]
+            Times in ``[0, end_time]``.
+        static_correction : bool
+            The mode-acceleration method (default); see :mod:`impactbeam.stress`.
+
+        Returns
+        -------
+        ndarray, (n_x, n_t), [N m]
+        """
+        from .stress import bending_moment
+
+        return bending_moment(self, points, times, static_correction=static_correction)
+
+    def bending_stress(self, points: Any, times: Any, *, static_correction: bool = True) -> np.ndarray:
+        """Outer-fibre bending stress ``M c / I`` [Pa] at any positions and times: array (n_x, n_t).
+
+        Parameters
+        ----------
+        points : float or array_like, [m]
+            Positions on the beam.
+        times : float or array_like, [s]
+            Times in ``[0, end_time]``.
+        static_correction : bool
+            As for :meth:`bending_moment`.
+
+        Returns
+        -------
+        ndarray, (n_x, n_t), [Pa]
+        """
+        from .stress import bending_stress
+
+        return bending_stress(self, points, times, static_correction=static_correction)
+
+    def final_state(self) -> ModalState:
+        """The modal state at the end of the run, to start another from (``simulate(..., start=)``).
+
+        Returns
+        -------
+        ModalState
+            At ``solution.t_end``, in the free state's basis. Only for the exact method.
+        """
+        from .solver.solution import basis_signature
+
+        if not hasattr(self.solution, "modal_state"):
+            raise ParameterError('final_state: only a run with method = "exact" has a modal state to continue from')
+        basis = basis_signature(self.beam, self.contactors, self.n_modes, self.options.get("basis", "enriched"))
+        return self.solution.modal_state(self.solution.t_end, basis)
 
     # ------------------------------------------------------------------ derived
     def metrics(self, *, impacts: bool = True) -> dict[str, Any]:
@@ -380,7 +423,18 @@ class SimulationResult:
         """
         from .metrics import compute_metrics
 
-        return compute_metrics(self, impacts=impacts)
+        out = compute_metrics(self, impacts=impacts)
+        if "stress" in self.fields:
+            from .stress import max_bending_stress
+
+            value, when, where = max_bending_stress(self)
+            out.update(max_bending_stress=value, max_bending_stress_time=when, max_bending_stress_position=where)
+        return out
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        """The fields of result files asked for by the scenario's ``[output] fields`` (canonical names)."""
+        return tuple(getattr(self.scenario, "output_fields", ()) or ())
 
     @property
     def impacts(self):
@@ -407,77 +461,9 @@ class SimulationResult:
         paper), the scenario as TOML text (``scenario``), the metrics as JSON
         (``metrics``), the solver options, status, message and warnings.
         """
-        import datetime
+        from ._dataset import result_dataset
 
-        import xarray as xr
-
-        from . import __version__
-
-        n_c = len(self.contactors)
-        kind = np.array([1 if e.kind == "impact" else 0 for e in self.events], dtype=np.int8)
-        flag = {"flag_values": np.array([0, 1], dtype=np.int8)}
-        ds = xr.Dataset(
-            {
-                "w": (("time", "point"), self.w, {"units": "m", "long_name": "deflection w(x, t)"}),
-                "w_t": (("time", "point"), self.w_t, {"units": "m s-1", "long_name": "velocity w_t(x, t)"}),
-                "contact_force": (
-                    ("time", "contactor"), self.contact_force, {"units": "N", "long_name": "contact force on the beam"}
-                ),
-                "engaged": (("time", "contactor"), self.engaged.astype(np.int8),
-                            {"long_name": "contactor state", **flag, "flag_meanings": "free engaged"}),
-                "w_contactor": (
-                    ("time", "contactor"), self.w_contact, {"units": "m", "long_name": "deflection at the contactor"}
-                ),
-                "modal_displacement": (
-                    ("time", "mode"), self.eta,
-                    {"long_name": "modal displacement in the basis of the current state",
-                     "comment": "mass-normalised modal coordinate: unit m kg^(1/2), which UDUNITS cannot express"},
-                ),
-                "modal_velocity": (
-                    ("time", "mode"), self.eta_t,
-                    {"long_name": "modal velocity", "comment": "unit m kg^(1/2) s^-1"},
-                ),
-                "event_time": (("event",), np.array([e.time for e in self.events], dtype=float),
-                               {"units": "s", "long_name": "event time"}),
-                "event_kind": (("event",), kind, {"long_name": "event kind", **flag,
-                                                  "flag_meanings": "rebound impact"}),
-                "event_contactor": (("event",), np.array([e.contactor for e in self.events], dtype=np.int32),
-                                    {"long_name": "contactor of the event"}),
-            },
-            coords={
-                "time": ("time", self.time, {"units": "s", "long_name": "time", "standard_name": "time"}),
-                "point": ("point", self.points, {"units": "m", "long_name": "position along the beam"}),
-                "contactor": ("contactor", np.arange(n_c, dtype=np.int32), {"long_name": "contactor index"}),
-                "contactor_position": (
-                    "contactor", np.array([c.position for c in self.contactors], dtype=float),
-                    {"units": "m", "long_name": "contactor position"},
-                ),
-                "mode": ("mode", np.arange(1, self.solution.n_modes + 1, dtype=np.int32),
-                         {"long_name": "mode number"}),
-                "event": ("event", np.arange(len(self.events), dtype=np.int32), {"long_name": "event number"}),
-            },
-            attrs={
-                "Conventions": "CF-1.10",
-                "title": f"impactbeam simulation: {self.scenario_name}",
-                "history": f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')}: "
-                           f"impactbeam {__version__} simulate",
-                "source": f"impactbeam {__version__}: exact piecewise modal solution (closed form between exact "
-                          "events)",
-                "references": _REFERENCE,
-                "impactbeam_version": __version__,
-                "status": self.status,
-                "message": self.message,
-                "warnings": "; ".join(self.warnings),
-                "n_modes": self.n_modes,
-                "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
-                "scenario": self.scenario.to_toml() if self.scenario is not None else "",
-                "metrics": metrics_json(self.metrics()),
-                **{f"solver_{k}": v for k, v in self.options.items()},
-            },
-        )
-        for name, arr in self.energy.items():
-            ds[f"energy_{name}"] = ("time", arr, {"units": "J", "long_name": f"energy: {name.replace('_', ' ')}"})
-        return ds
+        return result_dataset(self)
 
     def to_dataframe(self):
         """Wide table: time, w and w_t at each point, contact force per contactor, energies."""
@@ -496,37 +482,44 @@ class SimulationResult:
         return pd.DataFrame(cols)
 
     def plot(self, path: str | os.PathLike | None = None, **kwargs):
-        """Response figure; see :func:`impactbeam.plot.plot_result`."""
+        """Response figure; see :func:`impactbeam.plot.plot_result`.
+
+        Parameters
+        ----------
+        path : str or path-like, optional
+            Also save the figure there (format from the suffix).
+        **kwargs
+            Passed to :func:`impactbeam.plot.plot_result`.
+
+        Returns
+        -------
+        PlotHandles
+        """
         from .plot import plot_result
 
         return plot_result(self, path, **kwargs)
 
 
-def _json_default(o: Any) -> Any:
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    raise TypeError(type(o))
-
-
-def metrics_json(metrics: dict[str, Any]) -> str:
-    """JSON text of a metrics dict (NaN and inf become null)."""
-
-    def clean(v: Any) -> Any:
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [clean(x) for x in v]
-        if isinstance(v, (float, np.floating)):
-            return float(v) if math.isfinite(v) else None
-        if isinstance(v, np.integer):
-            return int(v)
-        return v
-
-    return json.dumps(clean(metrics), indent=2, default=_json_default)
-
-
 def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
-    """Write the full result to ``.nc`` (netCDF4/HDF5), ``.csv`` or ``.parquet``, atomically."""
+    """Write the full result to ``.nc`` (netCDF4/HDF5), ``.csv`` or ``.parquet``, atomically.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    path : str or path-like
+        The file; its suffix chooses the format (:data:`RESULT_SUFFIXES`).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    ParameterError
+        An unsupported suffix.
+    ResourceError
+        The sampled histories would exceed the memory limit.
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in RESULT_SUFFIXES:

@@ -64,6 +64,8 @@ DIMENSIONS: dict[str, _Dimension] = {
     "force": _Dimension("N", "N", "a force"),
     "force_per_length": _Dimension("N/m", "N/m", "a force per length"),
     "mass": _Dimension("kg", "kg", "a mass"),
+    "frequency": _Dimension("Hz", "Hz", "a frequency"),
+    "angle": _Dimension("rad", "rad", "an angle"),
     "rotary_inertia": _Dimension("kg m^2", "kg*m^2", "a rotary inertia"),
     "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
 }
@@ -119,6 +121,17 @@ def scale_decimal(number: str, factor: float) -> float:
     The product is formed in decimal arithmetic from the written number and
     the shortest repr of ``factor``, so ``"3.03 mm"`` gives exactly the float
     ``3.03e-3`` (a binary product would be one ulp off).
+
+    Parameters
+    ----------
+    number : str
+        The number as written.
+    factor : float
+        The SI factor of its unit.
+
+    Returns
+    -------
+    float
     """
     try:
         return float(Decimal(number.strip()) * Decimal(repr(factor)))
@@ -131,7 +144,17 @@ class _UnitProblem(Exception):
 
 
 def describe_dimension(dimension: str) -> str:
-    """``"an acceleration (m/s^2)"``: the expected kind of quantity, for messages."""
+    """``"an acceleration (m/s^2)"``: the expected kind of quantity, for messages.
+
+    Parameters
+    ----------
+    dimension : str
+        One of :data:`DIMENSIONS`.
+
+    Returns
+    -------
+    str
+    """
     dim = _dimension(dimension)
     return f"{dim.noun} ({dim.si_unit})" if dim.si_unit else dim.noun
 
@@ -319,8 +342,25 @@ def unit_scale(unit: str, dimension: str, key: str) -> float:
     """Factor that converts values in ``unit`` to the SI unit of ``dimension``.
 
     ``unit_scale("ms", "time", k)`` is 1e-3; ``unit_scale("g", "acceleration", k)``
-    is 9.80665. Used for column headers such as ``time [ms]``. Raises
-    :class:`ScenarioError` (with ``key``) for an unknown unit or a wrong dimension.
+    is 9.80665. Used for column headers such as ``time [ms]``.
+
+    Parameters
+    ----------
+    unit : str
+        A unit, e.g. ``"ms"`` or ``"N/mm"``.
+    dimension : str
+        One of :data:`DIMENSIONS`.
+    key : str
+        The field or column named in errors.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ScenarioError
+        An unknown unit, or one of another dimension.
     """
     text = unit.strip()
     try:

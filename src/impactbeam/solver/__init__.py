@@ -13,20 +13,23 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from ..beam import Beam, Contactor
+from ..model.beam import Beam, Contactor
 from .._warnings import emit_user_level_warning as warn
 from ..exceptions import ParameterError
-from ..loading import Excitation, InitialCondition
+from ..model.loading import Excitation, InitialCondition
 from .convergence import AUTO_COUNTS, relative_changes
 from .engine import integrate
-from .solution import Event, PiecewiseSolution, Solution
-from .options import Damping, SolverOptions
+from .solution import Event, ModalState, PiecewiseSolution, Solution, basis_signature
+from ..model import Damping, SolverOptions
 
 if TYPE_CHECKING:
     from ..result import SimulationResult
     from ..scenario import Scenario
 
-__all__ = ["simulate", "simulate_system", "Damping", "SolverOptions", "Event", "Solution", "PiecewiseSolution"]
+__all__ = [
+    "simulate", "simulate_system", "Damping", "SolverOptions", "Event", "Solution", "PiecewiseSolution",
+    "ModalState",
+]
 
 Method = Literal["exact", "ivp"]
 
@@ -43,8 +46,33 @@ def simulate_system(
     method: Method = "exact",
     progress: Callable[[float], None] | None = None,
     name: str = "system",
+    start: ModalState | None = None,
 ) -> SimulationResult:
-    """Simulate a beam given as objects rather than as a scenario; see :func:`simulate`."""
+    """Simulate a beam given as objects rather than as a scenario; see :func:`simulate`.
+
+    Parameters
+    ----------
+    beam : Beam
+    contactors : sequence of Contactor
+    damping : Damping, optional
+        Default: undamped.
+    excitation : Excitation, optional
+        Default: none.
+    initial : InitialCondition, optional
+        Default: at rest.
+    options : SolverOptions, optional
+        Default settings when None.
+    points : sequence of float, optional, [m]
+        Output points; default: the contactors, then the right end.
+    method : {"exact", "ivp"}
+        As for :func:`simulate`.
+    progress : callable, optional
+        As for :func:`simulate`.
+    name : str
+        Name of the run (in result files).
+    start : ModalState, optional
+        As for :func:`simulate`.
+    """
     from ..result import SimulationResult
 
     damping = damping or Damping()
@@ -75,25 +103,44 @@ def simulate_system(
     _check_distinct(contactors)
     if method not in ("exact", "ivp"):
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
+    _check_start(start, beam, contactors, options, method)
 
     def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
-        opt = dataclasses.replace(options, modes=n_modes)
+        opt = options if options.modes == n_modes else dataclasses.replace(options, modes=n_modes)
         if method == "ivp":
             from .reference import integrate_ivp
 
             solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt)
         else:
-            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress)
+            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress,
+                                 None if start is None else (start.eta, start.deta))
         if announce:
             for text in solution.warnings:
                 warn(text)
-        info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method}
+        info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method,
+                "basis": opt.basis}
         return SimulationResult(solution, pts_arr, beam, contactors, n_modes, opt.time_step, opt.end_time, name,
                                 info, rerun=functools.partial(run, announce=False), tolerance=opt.tolerance)
 
     if options.modes != "auto":
         return run(int(options.modes))
     return _auto_modes(run, options.tolerance)
+
+
+def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contactor, ...],
+                 options: SolverOptions, method: str) -> None:
+    """ParameterError unless ``start`` is a state of this model's free-state basis."""
+    if start is None:
+        return
+    if not isinstance(start, ModalState):
+        raise ParameterError(f"start: expected a ModalState (result.final_state()), got {type(start).__name__}")
+    if method != "exact" or options.modes == "auto":
+        raise ParameterError('start: a run from a modal state needs method = "exact" and a fixed solver.modes')
+    if start.basis != basis_signature(beam, contactors, int(options.modes), options.basis):
+        raise ParameterError(
+            "start: the state belongs to another modal basis (beam, contactor positions, solver.modes or "
+            "solver.basis differ); start from rest or from a state of this model"
+        )
 
 
 def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> SimulationResult:
@@ -149,6 +196,7 @@ def simulate(
     *,
     method: Method = "exact",
     progress: Callable[[float], None] | None = None,
+    start: ModalState | None = None,
 ) -> SimulationResult:
     """Transient response of the scenario's beam (paper section 2, eqs. 9-12).
 
@@ -162,6 +210,10 @@ def simulate(
         with events (a slower independent reference used by the tests).
     progress : callable, optional
         Called with the current simulated time as the run advances.
+    start : ModalState, optional
+        Begin at t = 0 from this state (``previous_result.final_state()``)
+        instead of ``[initial]``: a run continued from the end of another of
+        the same model (same beam, contactor positions, modes and basis).
 
     Returns
     -------
@@ -217,6 +269,7 @@ def simulate(
         method=method,
         progress=progress,
         name=scenario.name,
+        start=start,
     )
     object.__setattr__(res, "scenario", scenario)
     return res

@@ -20,16 +20,17 @@ from __future__ import annotations
 
 import logging
 import os
+import weakref
 from collections import OrderedDict
 from collections.abc import Callable
 
 import numpy as np
 
-from ..beam import Beam, Contactor
-from ..loading import Excitation, InitialCondition, time_pieces
-from ..modes import mode_set
+from ..model.beam import Beam, Contactor
+from ..model.loading import Excitation, InitialCondition, time_pieces
+from ..modal import mode_set
 from . import _loop
-from .options import Damping, SolverOptions
+from ..model import Damping, SolverOptions
 from .solution import Event, Solution
 from .states import StateModel, StateSpace
 
@@ -253,12 +254,19 @@ class _Records:
                 setattr(self, name, _grow(getattr(self, name), n))
 
 
+_PIECES: weakref.WeakKeyDictionary[Excitation, dict[float, tuple[np.ndarray, ...]]] = weakref.WeakKeyDictionary()
+
+
 def _pieces(excitation: Excitation, end_time: float) -> tuple[np.ndarray, ...]:
-    pieces = time_pieces(excitation, end_time)
-    return tuple(
-        np.array([getattr(p, f) for p in pieces], dtype=float)
-        for f in ("t0", "t1", "const", "slope", "amp", "Omega", "phase")
-    )
+    """The load pieces as arrays for the compiled loop, cached per (immutable) excitation and end time."""
+    per_end = _PIECES.setdefault(excitation, {})
+    if end_time not in per_end:
+        pieces = time_pieces(excitation, end_time)
+        per_end[end_time] = tuple(
+            np.array([getattr(p, f) for p in pieces], dtype=float)
+            for f in ("t0", "t1", "const", "slope", "amp", "Omega", "phase")
+        )
+    return per_end[end_time]
 
 
 def _call(pk: _Packed, con: tuple[np.ndarray, ...], pcs: tuple[np.ndarray, ...], opt: SolverOptions, tol_h: float,
@@ -285,8 +293,12 @@ def integrate(
     initial: InitialCondition,
     options: SolverOptions,
     progress: Callable[[float], None] | None = None,
+    start: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Solution:
     """Run the exact event-driven integration; see :func:`impactbeam.simulate`.
+
+    ``start``: free-state modal displacement and velocity at t = 0 (replaces
+    ``initial``); see :meth:`Solution.modal_state`.
 
     Returns
     -------
@@ -308,7 +320,12 @@ def integrate(
     fc[_loop.F_LAST_T] = -1.0
     ic = np.zeros(_loop.N_INT, dtype=np.int64)
     ic[[_loop.I_JUST, _loop.I_PENDING, _loop.I_WARN_C]] = -1
-    eta, deta = space_initial_coordinates(pk.space, beam, initial, options.modes)
+    if start is None:
+        eta, deta = space_initial_coordinates(pk.space, beam, initial, options.modes)
+    else:
+        eta, deta = (np.array(v, dtype=float) for v in start)
+        if eta.shape != (nm,) or deta.shape != (nm,):
+            raise ValueError(f"start: expected two arrays of {nm} modal coordinates")
     eta = np.ascontiguousarray(eta, dtype=float)
     deta = np.ascontiguousarray(deta, dtype=float)
     toggles = np.zeros(max(len(contactors), 1), dtype=np.int64)
@@ -336,8 +353,9 @@ def integrate(
 def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solution:
     nseg, nev, njump = int(ic[_loop.I_NSEG]), int(ic[_loop.I_NEV]), int(ic[_loop.I_NJUMP])
     events = [
-        Event(float(rec.ev_t[i]), "impact" if rec.ev_kind[i] else "rebound", int(rec.ev_c[i]), float(rec.ev_v[i]))
-        for i in range(nev)
+        Event(t, "impact" if k else "rebound", c, v)
+        for t, k, c, v in zip(rec.ev_t[:nev].tolist(), rec.ev_kind[:nev].tolist(), rec.ev_c[:nev].tolist(),
+                              rec.ev_v[:nev].tolist())
     ]
     t_stop = float(fc[_loop.F_T])
     if status == _loop.CHATTER:

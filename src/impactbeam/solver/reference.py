@@ -10,7 +10,7 @@ in each state (the set of engaged contactors, with the same mode sets from
 :class:`~impactbeam.solver.states.StateSpace`), but by a general-purpose
 Runge-Kutta method (DOP853, ``rtol = 1e-10``) instead of the closed form,
 with the time history ``u(t)`` written out from the fields of the
-:class:`~impactbeam.loading.Excitation` rather than taken from the exact
+:class:`~impactbeam.model.loading.Excitation` rather than taken from the exact
 solver's closed-form load pieces. Contact changes are terminal
 ``solve_ivp`` events on each contactor's opening ``g = c - s w(a)`` with a
 direction (downward crossing while open: impact; upward crossing while
@@ -41,12 +41,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from ..beam import Beam, Contactor
+from ..model.beam import Beam, Contactor
 from ..exceptions import SimulationError
-from ..loading import Excitation, InitialCondition
+from ..model.loading import Excitation, InitialCondition
 from .engine import make_space, space_initial_coordinates
 from .solution import Event, PiecewiseSolution, Samples
-from .options import Damping, SolverOptions
+from ..model import Damping, SolverOptions
 from .states import StateModel
 
 __all__ = ["integrate_ivp", "IvpSegment", "IvpDense", "IvpSolution", "RTOL"]
@@ -99,7 +99,7 @@ def _load_breaks(excitation: Excitation, end_time: float) -> list[float]:
     if excitation.shape == "half_sine":
         assert excitation.duration is not None
         cand = [s, s + excitation.duration]
-    elif excitation.shape == "step":
+    elif excitation.shape in ("step", "harmonic"):
         cand = [s]
     else:
         assert excitation.times is not None
@@ -130,6 +130,11 @@ def _history_on(excitation: Excitation, a: float, b: float):
     if excitation.shape == "step":
         val = s * excitation.amplitude if tau_mid >= 0.0 else 0.0
         return lambda t: val
+    if excitation.shape == "harmonic":
+        if tau_mid < 0.0:
+            return lambda t: 0.0
+        amp, om, ph = s * excitation.amplitude, 2.0 * math.pi * float(excitation.frequency), excitation.phase
+        return lambda t: amp * math.sin(om * (t - start) + ph)
     tk, vk = excitation.times, excitation.values
     assert tk is not None and vk is not None
     if not tk[0] <= tau_mid <= tk[-1]:

@@ -61,14 +61,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..beam import Beam, Contactor
+from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
-from ..loading import Excitation, InitialCondition, spatial_projection
-from ..modes import ModeSet, mode_set
-from .options import Damping
+from ..model.loading import Excitation, InitialCondition, spatial_projection
+from ..modal import mode_set
+from ..model import Damping
 from .states import ModalDynamics, StateModel
 
-__all__ = ["RitzBasis", "RitzModes", "RitzStateSpace", "ritz_basis"]
+__all__ = ["RitzBasis", "RitzModes", "RitzStateSpace", "ritz_basis", "static_polynomial"]
 
 _MERGE = 3e-5  # contactors closer than this fraction of L share one attachment shape
 _DROP = 1e-11  # a residual shape smaller than this fraction of its static shape is dropped
@@ -108,37 +108,49 @@ def _cubic_derivs(xi: float) -> np.ndarray:
     ])
 
 
-def _static_coefficients(beam: Beam, alpha: float, q0: float, q1: float) -> np.ndarray:
-    """Polynomial coefficients (2 segments, 6 powers of xi) of ``ghat`` under a unit force at ``xi = alpha``.
+def static_polynomial(beam: Beam, alpha: float, loads: np.ndarray, jump: float) -> np.ndarray:
+    """Coefficients (2 segments, powers of xi) of ``ghat`` with ``ghat'''' = loads[s](xi)`` on each side.
 
-    ``ghat'''' = q0 + q1 xi`` (inertia relief, zero without rigid-body modes)
-    plus the unit jump ``ghat'''(alpha+) - ghat'''(alpha-) = 1``; end conditions of
-    DESIGN.md section 1. A singular system (rigid-body motion) is solved in
-    the least-squares sense; the caller removes the rigid-body part.
+    ``loads`` (2, m) holds the polynomial load of the segments left and right
+    of ``xi = alpha``; ``jump`` is ``ghat'''(alpha+) - ghat'''(alpha-)`` (1 for a
+    unit point force there, 0 for none); ``ghat, ghat', ghat''`` are continuous;
+    end conditions of DESIGN.md section 1. A singular system (rigid-body motion)
+    is solved in the least-squares sense; the caller removes the rigid-body part.
     """
-    part = np.array([0.0, 0.0, 0.0, 0.0, q0 / 24.0, q1 / 120.0])  # shared particular solution
-    dpart = [np.polynomial.polynomial.polyder(part, k) if k else part for k in range(4)]
+    m = loads.shape[1]
+    part = np.zeros((2, m + 4))
+    for k in range(m):  # four integrations of xi^k
+        part[:, k + 4] = loads[:, k] * math.factorial(k) / math.factorial(k + 4)
+    dpart = [[np.polynomial.polynomial.polyder(part[s], k) if k else part[s] for k in range(4)] for s in (0, 1)]
 
-    def pd(xi: float) -> np.ndarray:
-        return np.array([np.polynomial.polynomial.polyval(xi, d) for d in dpart])
+    def pd(side: int, xi: float) -> np.ndarray:
+        return np.array([np.polynomial.polynomial.polyval(xi, d) for d in dpart[side]])
 
     left, right = _bc_rows(beam)
     A = np.zeros((8, 8))
     b = np.zeros(8)
     A[0:2, 0:4] = left @ _cubic_derivs(0.0)
-    b[0:2] = -left @ pd(0.0)
+    b[0:2] = -left @ pd(0, 0.0)
     D = _cubic_derivs(alpha)
     A[2:6, 0:4] = D
     A[2:6, 4:8] = -D
-    b[5] = -1.0  # g'''(a-) - g'''(a+) = -1
+    b[2:6] = pd(1, alpha) - pd(0, alpha)
+    b[5] -= jump  # g'''(a-) - g'''(a+) = -jump
     A[6:8, 4:8] = right @ _cubic_derivs(1.0)
-    b[6:8] = -right @ pd(1.0)
+    b[6:8] = -right @ pd(1, 1.0)
     c, *_ = np.linalg.lstsq(A, b, rcond=1e-13)
-    out = np.zeros((2, 6))
-    out[0, :4] = c[:4]
-    out[1, :4] = c[4:]
-    out += part
+    out = part.copy()
+    out[0, :4] += c[:4]
+    out[1, :4] += c[4:]
     return out
+
+
+def _static_coefficients(beam: Beam, alpha: float, q0: float, q1: float) -> np.ndarray:
+    """Coefficients (2, 6) of ``ghat`` under a unit force at ``xi = alpha`` with ``ghat'''' = q0 + q1 xi``.
+
+    The load is the inertia relief of rigid-body modes (zero without them).
+    """
+    return static_polynomial(beam, alpha, np.array([[q0, q1], [q0, q1]]), 1.0)
 
 
 # --------------------------------------------------------------------------- the basis
@@ -329,7 +341,7 @@ def ritz_basis(beam: Beam, positions: Sequence[float], n_modes: int) -> RitzBasi
 class RitzModes:
     """Modes of one state in the shared basis: ``W_m(x) = sum_j Phi[j, m] psi_j(x)``.
 
-    Offers the part of :class:`~impactbeam.modes.ModeSet`'s interface the
+    Offers the part of :class:`~impactbeam.modal.ModeSet`'s interface the
     solver and the results use (``omega``, ``count``, ``frequencies_hz``,
     ``shapes``, ``integral``). They are mass-orthonormal
     (``rho A int W_n W_m dx = delta_nm``) and there are ``N + n_a`` of them:

@@ -11,7 +11,7 @@ use, which the ``solve_ivp`` reference path implements too.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -19,13 +19,12 @@ from ..exceptions import ParameterError
 from . import _dense
 
 if TYPE_CHECKING:
-    from ..beam import Contactor
+    from ..model.beam import Contactor
 
-__all__ = ["Event", "Samples", "PiecewiseSolution", "Solution"]
+__all__ = ["Event", "Samples", "PiecewiseSolution", "Solution", "ModalState"]
 
 
-@dataclass(frozen=True)
-class Event:
+class Event(NamedTuple):
     """An impact (contactor engages) or rebound (it releases) at an exact time.
 
     Attributes
@@ -45,15 +44,56 @@ class Event:
 
 
 @dataclass(frozen=True, eq=False)
-class Samples:
-    """Values of a solution at given times (rows = times)."""
+class ModalState:
+    """The state of the N-mode model at one instant, to start another run from.
 
-    w: np.ndarray  # (n_t, n_x) [m]
-    w_t: np.ndarray  # (n_t, n_x) [m/s]
-    engaged: np.ndarray  # (n_t, n_c) bool
-    eta: np.ndarray | None = None  # (n_t, n_modes), basis of the state at each time
+    Attributes
+    ----------
+    time : float, [s]
+        When the state was taken (informative: a run started from it begins at t = 0).
+    eta, deta : ndarray
+        Modal displacement and velocity in the free state's basis (the
+        ``n_modes`` free modes, plus one attachment shape per contactor
+        position with ``solver.basis = "enriched"``).
+    basis : tuple
+        What the free state's basis depends on (beam, contactor positions,
+        mode count, basis kind); a run accepts the state only in the same basis.
+    """
+
+    time: float
+    eta: np.ndarray
+    deta: np.ndarray
+    basis: tuple
+
+
+def basis_signature(beam: Any, contactors: Any, modes: int, basis: str) -> tuple:
+    """What the free state's modal basis depends on (see :class:`ModalState`)."""
+    positions = tuple(float(c.position) for c in contactors) if basis == "enriched" else ()
+    return (beam, positions, int(modes), basis)
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """Values of a solution at given times (rows = times).
+
+    Attributes
+    ----------
+    w, w_t : ndarray, (n_t, n_x), [m], [m/s]
+        Deflection and velocity.
+    engaged : ndarray of bool, (n_t, n_c)
+        Contactors engaged.
+    eta, eta_t : ndarray or None, (n_t, n_modes)
+        Modal coordinates in the basis of the state at each time (when asked for).
+    energies : ndarray or None, (n_t, 4)
+        Kinetic energy, modal strain energy, load power, damping power (when asked for).
+    """
+
+    w: np.ndarray
+    w_t: np.ndarray
+    engaged: np.ndarray
+    eta: np.ndarray | None = None
     eta_t: np.ndarray | None = None
-    energies: np.ndarray | None = None  # (n_t, 4): kinetic, modal strain, load power, damping power
+    energies: np.ndarray | None = None
 
 
 class PiecewiseSolution:
@@ -83,7 +123,16 @@ class PiecewiseSolution:
     n_modes: int
 
     def check_times(self, t: Any, end_time: float, name: str = "t") -> np.ndarray:
-        """Times as a float array; ParameterError outside ``[0, end_time]``."""
+        """Times as a float array; ParameterError outside ``[0, end_time]``.
+
+        Parameters
+        ----------
+        t : float or array_like, [s]
+        end_time : float, [s]
+            End of the simulated interval.
+        name : str
+            The argument named in the error.
+        """
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if t.ndim != 1:
             raise ParameterError(f"{name}: expected a 1-D array of times, got shape {t.shape}")
@@ -95,6 +144,19 @@ class PiecewiseSolution:
         return t
 
     def sample(self, x: np.ndarray, t: np.ndarray, *, modal: bool = False, energy: bool = False) -> Samples:
+        """Exact values at times ``t`` and positions ``x`` (NaN after ``t_end``).
+
+        Parameters
+        ----------
+        x : ndarray, [m]
+            Positions on the beam.
+        t : ndarray, [s]
+            Times, in any order.
+        modal : bool
+            Also the modal coordinates (in the basis of the state at each time).
+        energy : bool
+            Also the energy terms (kinetic, modal strain, load power, damping power).
+        """
         raise NotImplementedError
 
     def extremum(self, x: float, lo: float, hi: float, sign: float = 1.0, offset: float = 0.0,
@@ -103,19 +165,52 @@ class PiecewiseSolution:
 
         With ``engaged = c`` only the times when contactor ``c`` is engaged count.
         Returns ``(-inf, nan)`` when no time qualifies.
+
+        Parameters
+        ----------
+        x : float, [m]
+            Position on the beam.
+        lo, hi : float, [s]
+            The time interval.
+        sign : float
+            +1 for the maximum of ``w + offset``, -1 for the minimum.
+        offset : float, [m]
+            Added to ``w``.
+        engaged : int or None
+            Only times when this contactor is engaged.
         """
         raise NotImplementedError
 
     def integral(self, x: float, lo: float, hi: float) -> float:
-        """``int_lo^hi w(x, t) dt`` [m s]."""
+        """``int_lo^hi w(x, t) dt`` [m s].
+
+        Parameters
+        ----------
+        x : float, [m]
+            Position on the beam.
+        lo, hi : float, [s]
+            The time interval.
+        """
         raise NotImplementedError
 
     def extrema(self, queries: list[tuple]) -> np.ndarray:
-        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged)``: array (n, 2)."""
+        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged)``: array (n, 2).
+
+        Parameters
+        ----------
+        queries : list of tuple
+            Each ``(x, lo, hi, sign, offset, engaged)`` as for :meth:`extremum`.
+        """
         return np.array([self.extremum(*q) for q in queries], dtype=float).reshape(len(queries), 2)
 
     def integrals(self, queries: list[tuple[float, float, float]]) -> np.ndarray:
-        """Several :meth:`integral` queries ``(x, lo, hi)``."""
+        """Several :meth:`integral` queries ``(x, lo, hi)``.
+
+        Parameters
+        ----------
+        queries : list of tuple
+            Each ``(x, lo, hi)`` as for :meth:`integral`.
+        """
         return np.array([self.integral(*q) for q in queries], dtype=float)
 
 
@@ -125,6 +220,34 @@ class Solution(PiecewiseSolution):
     Segment ``j`` covers ``[t0[j], t1[j]]`` in state slot ``slot[j]`` (the set
     of engaged contactors ``engaged(j)``) under load piece ``piece[j]``,
     starting from the modal state ``eta0[j], deta0[j]`` in that state's basis.
+    Built by :func:`~impactbeam.solver.engine.integrate`, not by users.
+
+    Parameters
+    ----------
+    t0, t1, slot, piece : ndarray, (n_segments,)
+        Start and end time [s], state slot and load piece of each segment.
+    eta0, deta0 : ndarray, (n_segments, n_state_modes)
+        Modal state at the start of each segment.
+    packed : Packed
+        The compiled model: every visited state's modes and coefficients.
+    pieces : tuple of ndarray
+        The load pieces (:func:`impactbeam.model.loading.time_pieces`).
+    contactor_arrays : tuple of ndarray
+        Positions, stiffnesses, gaps and sides of the contactors.
+    contactors : tuple of Contactor
+    events : list of Event
+    energy_jumps : ndarray, [J]
+        Change of mechanical energy at each switch.
+    status : int
+        0: reached ``end_time``; 1: stopped by the chattering guard.
+    message : str
+    warnings : tuple of str
+    t_end : float, [s]
+        Where the solution ends.
+    evaluations : int
+        Closed-form evaluations the run took.
+    n_modes : int
+        Coordinates of the state bases.
     """
 
     def __init__(self, *, t0, t1, slot, piece, eta0, deta0, packed, pieces, contactor_arrays, contactors,
@@ -148,13 +271,20 @@ class Solution(PiecewiseSolution):
         self.evaluations = evaluations
         self.n_modes = n_modes
         self._atol = 1e-12 * float(packed.space.beam.length)
+        self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
 
     @property
     def n_segments(self) -> int:
         return int(self.t0.size)
 
     def engaged(self, j: int) -> tuple[int, ...]:
-        """Engaged contactors of segment ``j``."""
+        """Engaged contactors of segment ``j``.
+
+        Parameters
+        ----------
+        j : int
+            Segment index.
+        """
         return self.packed.keys[int(self.slot[j])]
 
     def _arrays(self) -> tuple:
@@ -163,15 +293,32 @@ class Solution(PiecewiseSolution):
                 self.pieces[0], *self.pieces[2:])
 
     def rows(self, x: np.ndarray) -> np.ndarray:
-        """Mode shapes of every visited state at ``x``: shape (n_states, len(x), n_modes)."""
-        return self.packed.rows(np.asarray(x, dtype=float))
+        """Mode shapes of every visited state at ``x``: shape (n_states, len(x), n_modes) (cached per ``x``).
+
+        Parameters
+        ----------
+        x : ndarray, [m]
+            Positions on the beam.
+        """
+        x = np.asarray(x, dtype=float)
+        if x.size > 64:
+            return self.packed.rows(x)
+        key = x.tobytes()
+        if key not in self._rows:
+            self._rows[key] = self.packed.rows(x)
+        return self._rows[key]
 
     def segment_index(self, t: np.ndarray) -> np.ndarray:
-        """Segment holding each time (an event time belongs to the segment it starts)."""
+        """Segment holding each time (an event time belongs to the segment it starts).
+
+        Parameters
+        ----------
+        t : ndarray, [s]
+            Times.
+        """
         return np.clip(np.searchsorted(self.t0, t, side="right") - 1, 0, max(self.n_segments - 1, 0))
 
     def sample(self, x: np.ndarray, t: np.ndarray, *, modal: bool = False, energy: bool = False) -> Samples:
-        """Exact values at times ``t`` (any order) and positions ``x``; NaN after ``t_end``."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         t = np.atleast_1d(np.asarray(t, dtype=float))
         nt, nx, nm = t.size, x.size, self.n_modes
@@ -203,7 +350,6 @@ class Solution(PiecewiseSolution):
         return np.ascontiguousarray(R.transpose(1, 0, 2)), row
 
     def extrema(self, queries: list[tuple]) -> np.ndarray:
-        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged)`` at once: (n, 2)."""
         n = len(queries)
         out = np.empty((2, n))
         out[0] = -np.inf
@@ -225,7 +371,6 @@ class Solution(PiecewiseSolution):
         return float(v), float(t)
 
     def integrals(self, queries: list[tuple[float, float, float]]) -> np.ndarray:
-        """Several :meth:`integral` queries ``(x, lo, hi)`` at once."""
         n = len(queries)
         out = np.zeros(n)
         if n and self.n_segments:
@@ -238,3 +383,28 @@ class Solution(PiecewiseSolution):
 
     def integral(self, x: float, lo: float, hi: float) -> float:
         return float(self.integrals([(x, lo, hi)])[0])
+
+    def modal_state(self, t: float, basis: tuple = ()) -> ModalState:
+        """The exact modal state at time ``t`` carried into the free state's basis.
+
+        With the shared (enriched) basis the change of basis is exact; with
+        the paper's per-state modes it is the projection of eq. (12), the one
+        a switch into the free state makes. ``basis`` is stored in the result
+        (see :func:`basis_signature`).
+
+        Parameters
+        ----------
+        t : float, [s]
+            A time of the solution.
+        basis : tuple
+            What the free state's basis depends on (:func:`basis_signature`).
+        """
+        t = float(self.check_times(t, self.t_end)[0])
+        smp = self.sample(np.zeros(1), np.array([t]), modal=True)
+        j = int(self.segment_index(np.array([t]))[0])
+        key = self.engaged(j)
+        eta, deta = smp.eta[0], smp.eta_t[0]  # type: ignore[index]
+        if key:
+            T = self.packed.space.transfer((), key, self.packed.preserve)
+            eta, deta = T @ eta, T @ deta
+        return ModalState(t, np.array(eta, dtype=float), np.array(deta, dtype=float), basis)

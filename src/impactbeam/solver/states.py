@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..beam import Beam, Contactor
-from ..loading import Excitation, spatial_projection
-from ..modes import ModeSet, mode_set
-from .options import Damping
+from ..model.beam import Beam, Contactor
+from ..model.loading import Excitation, spatial_projection
+from ..modal import ModeSet, mode_set
+from ..model import Damping
 
 __all__ = ["ModalDynamics", "StateModel", "StateSpace"]
 

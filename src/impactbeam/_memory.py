@@ -1,0 +1,127 @@
+"""Output sizes and the memory limit: sampled histories are estimated before they are allocated.
+
+A result's histories (``w`` at the output points and contactors, contact
+forces, modal coordinates, energies) are evaluated lazily; before any of them
+is allocated, :func:`check_output_size` compares the estimate with
+:func:`memory_limit` and refuses a request that would not fit, with the
+estimate and a way to ask for less.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from .exceptions import ParameterError, ResourceError
+
+__all__ = ["sample_count", "memory_limit", "check_memory", "output_bytes", "check_output_size"]
+
+
+def sample_count(end_time: float, time_step: float) -> int:
+    """Number of output samples ``0, dt, 2 dt, ... <= end_time`` (a relative 1e-12 of round-off tolerated).
+
+    Parameters
+    ----------
+    end_time, time_step : float, [s]
+
+    Returns
+    -------
+    int
+    """
+    return int(math.floor(end_time / time_step * (1.0 + 1e-12))) + 1
+
+
+def memory_limit() -> int:
+    """Bytes a request may allocate for sampled histories.
+
+    The smallest of: ``IMPACTBEAM_MEMORY_LIMIT`` (bytes, or a number with a
+    ``K``, ``M`` or ``G`` suffix; default 4 GiB), half of the machine's
+    physical memory, and 80 % of the process's address-space limit
+    (``ulimit -v``) when one is set.
+    """
+    raw = os.environ.get("IMPACTBEAM_MEMORY_LIMIT", "").strip().upper()
+    limit = 4 << 30
+    if raw:
+        mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
+        try:
+            limit = int(float(raw.rstrip("KMGB") or "nan") * mult)
+        except ValueError:
+            raise ParameterError(f"IMPACTBEAM_MEMORY_LIMIT: not a size: {raw!r}") from None
+    try:
+        limit = min(limit, os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2)
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        pass
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft != resource.RLIM_INFINITY:
+            limit = min(limit, int(0.8 * soft))
+    except (ImportError, OSError, ValueError):  # pragma: no cover - not POSIX
+        pass
+    return limit
+
+
+def check_memory(nbytes: float, what: str, hint: str) -> None:
+    """Raise ResourceError before allocating more than :func:`memory_limit`.
+
+    Parameters
+    ----------
+    nbytes : float
+        What the request would allocate.
+    what : str
+        The request, for the message (e.g. ``"the sampled histories"``).
+    hint : str
+        How to ask for less, for the message.
+
+    Raises
+    ------
+    ResourceError
+    """
+    limit = memory_limit()
+    if nbytes > limit:
+        raise ResourceError(
+            f"{what} would need {nbytes / 2**30:.3g} GiB, above the limit of {limit / 2**30:.3g} GiB; {hint} "
+            "(or raise IMPACTBEAM_MEMORY_LIMIT)"
+        )
+
+
+def output_bytes(n_times: int, n_points: int, n_contactors: int, n_modes: int, *, modal: bool = True) -> int:
+    """Estimated peak bytes of the sampled histories of a result and one copy of them.
+
+    ``w, w_t`` at the points and the contactors, contact forces and states,
+    and, with ``modal``, the modal coordinates and the seven energy series; the
+    factor 2 covers the copy a Dataset or DataFrame makes.
+
+    Parameters
+    ----------
+    n_times, n_points, n_contactors, n_modes : int
+        Output samples, output points, contactors and modes per state.
+    modal : bool
+        Whether the modal coordinates and energy series are asked for too.
+
+    Returns
+    -------
+    int
+    """
+    per = 8 * (2 * (n_points + n_contactors) + 2 * n_contactors) + n_contactors
+    if modal:
+        per += 8 * (2 * n_modes + 4 + 7)
+    return 2 * per * n_times
+
+
+def check_output_size(n_times: int, n_points: int, n_contactors: int, n_modes: int, modal: bool = True) -> None:
+    """Raise ResourceError, before any work, when :func:`output_bytes` exceeds :func:`memory_limit`.
+
+    Parameters
+    ----------
+    n_times, n_points, n_contactors, n_modes : int
+        Output samples, output points, contactors and modes per state.
+    modal : bool
+        Whether the modal coordinates and energy series are asked for too.
+    """
+    check_memory(
+        output_bytes(n_times, n_points, n_contactors, n_modes, modal=modal),
+        f"sampling {n_times} output times at {n_points} points" + (f" with {n_modes} modal coordinates" if modal else ""),
+        "use a larger solver.time_step, fewer output points or a shorter end_time",
+    )

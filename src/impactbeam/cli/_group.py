@@ -1,0 +1,193 @@
+"""The ``impactbeam`` command group and what every subcommand shares.
+
+Every command reports bad input (:class:`~impactbeam.exceptions.ParameterError`,
+which includes :class:`~impactbeam.exceptions.ScenarioError`) as exactly one
+line ``error: <message>`` on stderr and exits with status 2; a failed
+computation (:class:`~impactbeam.exceptions.SimulationError` and other
+:class:`~impactbeam.exceptions.ImpactBeamError`) exits with status 1. Never a
+traceback for those.
+
+Ctrl-C ends a command with status 130 and SIGTERM with 143, with one line
+and never a traceback (:class:`_Commands`). Warnings raised while a command
+runs are collected (:func:`take_warnings`) so the command can show them in its
+summary and its ``--json``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import functools
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator, Mapping
+from typing import Any, TypeVar
+
+import click
+
+from .._warnings import WarningLog
+from ..exceptions import ImpactBeamError, ParameterError
+
+__all__ = ["main", "handle_errors", "take_warnings", "warning_lines", "load_with_overrides", "Interrupted", "fail", "progress_bar", "number_or_text"]
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+def fail(message: str, status: int) -> None:
+    """Print one ``error:`` line on stderr and exit with ``status``."""
+    one_line = " ".join(str(message).split())
+    click.echo(f"error: {one_line}", err=True)
+    sys.exit(status)
+
+
+_WARNING_LOG: contextvars.ContextVar[WarningLog | None] = contextvars.ContextVar("warning_log", default=None)
+
+
+def take_warnings() -> list[str]:
+    """The ImpactBeamWarnings raised so far in the running command (each once).
+
+    A command that reports them itself (in its summary as ``warning: ...``
+    lines and in ``--json`` as ``"warnings"``) calls this; otherwise
+    :func:`handle_errors` prints them on stderr when the command ends.
+    """
+    log = _WARNING_LOG.get()
+    return [] if log is None else log.take()
+
+
+def warning_lines(messages: list[str]) -> list[str]:
+    """``warning: <message>`` lines for a terminal summary."""
+    return [f"warning: {m}" for m in messages]
+
+
+def handle_errors(fn: F) -> F:
+    """Decorator for commands: bad input -> exit 2, failed computation -> exit 1.
+
+    It also records the :class:`~impactbeam.exceptions.ImpactBeamWarning` s
+    raised during the command (see :func:`take_warnings`); those the command
+    did not report are printed on stderr as ``warning: ...`` when it succeeds
+    (an error exit prints only its one ``error:`` line). Other modules that
+    register subcommands should use it too.
+    """
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with WarningLog() as log:
+            token = _WARNING_LOG.set(log)
+            try:
+                out = fn(*args, **kwargs)
+            except ParameterError as exc:
+                fail(str(exc), 2)
+            except ImpactBeamError as exc:  # SimulationError, ModeSolveError, ...
+                fail(str(exc), 1)
+            finally:
+                _WARNING_LOG.reset(token)
+        if not log.consumed:
+            for line in warning_lines(log.messages):
+                click.echo(line, err=True)
+        return out
+
+    return wrapper  # type: ignore[return-value]
+
+
+def number_or_text(value: Any) -> Any:
+    """A command-line value as a number when it reads as one (SI), else the text (a value with its unit)."""
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return value
+    return value
+
+
+def load_with_overrides(path: str, overrides: Mapping[str, Any] | None = None) -> Any:
+    """The scenario at ``path`` with command-line ``overrides`` (dotted key -> value; None = not given)."""
+    from ..scenario import load_scenario
+
+    scenario = load_scenario(path)
+    # a command-line number is documented as SI: pass it as a number (a string would be a unit-less string)
+    overrides = {k: number_or_text(v) for k, v in (overrides or {}).items() if v is not None}
+    if overrides:
+        scenario = scenario.with_values(overrides)
+    return scenario
+
+
+@contextlib.contextmanager
+def progress_bar(
+    total: float, *, desc: str, unit: str, after: float = 2.0, **tqdm_options: Any
+) -> Iterator[Callable[[float], None]]:
+    """A callback ``report(done)`` that shows a bar on stderr once a command has run ``after`` seconds.
+
+    Parameters
+    ----------
+    total : float
+        What ``done`` reaches at the end (simulated seconds, values, cases ...).
+    desc, unit : str
+        The bar's label and unit.
+    after : float, [s]
+        Quiet for short commands: no bar before this much wall time.
+    **tqdm_options
+        Passed to :class:`tqdm.tqdm` (e.g. ``unit_scale``, ``bar_format``).
+    """
+    start = time.monotonic()
+    bar: Any = None
+
+    def report(done: float) -> None:
+        nonlocal bar
+        if bar is None and time.monotonic() - start > after:
+            from tqdm import tqdm
+
+            bar = tqdm(total=total, unit=unit, desc=desc, file=sys.stderr, **tqdm_options)
+        if bar is not None:
+            bar.update(max(0.0, min(done, total) - bar.n))
+
+    try:
+        yield report
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM (or SIGINT) received: the command stops, keeping finished work, exit 128 + signum."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(f"interrupted by signal {signum}")
+        self.signum = signum
+
+
+def _raise_interrupted(signum: int, frame: Any) -> None:
+    raise Interrupted(signum)
+
+
+class _Commands(click.Group):
+    """The command group: Ctrl-C exits 130 and SIGTERM 143, with one line, never a traceback."""
+
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        previous = None
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGTERM, _raise_interrupted)
+        try:
+            return super().main(*args, **kwargs)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            signum = int(getattr(exc, "signum", signal.SIGINT))
+            click.echo(f"interrupted ({signal.Signals(signum).name}): stopped; finished files are kept, "
+                       "nothing half-written", err=True)
+            sys.exit(128 + signum)
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="impactbeam", prog_name="impactbeam")
+def main() -> None:
+    """Transient response of beams that impact stops (Xu & Ervin 2013, extended).
+
+    A scenario is a TOML file (see examples/README.md). Bad input exits with
+    status 2 and one line on stderr; a failed computation with status 1.
+    """

@@ -1,0 +1,368 @@
+"""Stroboscopic (Poincaré) sampling of a harmonically forced run and its period.
+
+Under the harmonic load ``u(t) = A sin(2 pi f (t - start) + phase)`` the
+forcing period is ``T = 1/f``. A run of ``settle + record`` periods is
+sampled exactly (closed form, no interpolation) at the strobe times
+``t_k = start + k T``; the last ``record`` samples form the Poincaré section.
+
+The response period ``n`` (in forcing periods) is the smallest ``n`` with
+``|s_{k+n} - s_k| <= tolerance * scale`` for every recorded sample, where
+``s_k`` is the state sampled at the strobe time: deflection and velocity at
+the contactors, the output points and along the beam, each group scaled by
+its largest magnitude over the record. ``n`` is looked for up to
+``record // 2`` (two repeats at least). None found means chaotic or
+quasi-periodic motion, or a transient not yet decayed: the result says so
+with a warning.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .._warnings import emit_user_level_warning
+from ..exceptions import ScenarioError
+
+if TYPE_CHECKING:
+    from ..result import SimulationResult
+    from ..scenario import Scenario
+    from ..solver.solution import ModalState
+
+__all__ = ["SteadyState", "steady_state", "analyse_steady_state", "detect_period", "strobe_point",
+           "harmonic_period"]
+
+#: Default relative tolerance of the period test (see the module docstring).
+PERIOD_TOLERANCE = 1e-4
+
+
+@dataclass(frozen=True, eq=False)
+class SteadyState:
+    """The recorded steady state of a harmonically forced run.
+
+    Attributes
+    ----------
+    frequency : float, [Hz]
+        Forcing frequency.
+    period : int
+        Response period in forcing periods (1, 2, 3, ...); 0 when none was
+        found within the record (see ``warnings``).
+    impacts_per_period : float
+        Impacts (all contactors) in one response period; without a period,
+        the mean number per forcing period over the record.
+    strobe : ndarray, (record,), [m]
+        ``w`` at ``point`` at ``t_k = start + k / f``, ``k = settle .. settle + record - 1``.
+    strobe_velocity : ndarray, (record,), [m/s]
+    times : ndarray, (record,), [s]
+        The strobe times.
+    max, min : float, [m]
+        Extremes of ``w`` at ``point`` over the record (exact, closed form).
+    mismatch : float
+        The relative mismatch of the period test for ``period`` (the smallest
+        over the candidates when none passed).
+    point : float, [m]
+        Where ``w`` is sampled: the first contactor, else the first output point.
+    window : tuple of float, [s]
+        The recorded interval (in the clock of the last run).
+    settled_after : int
+        Forcing periods run before the record (more than asked for when the
+        period test failed and the run was extended, see :func:`steady_state`).
+    result : SimulationResult
+        The run (dense output over settle and record).
+    warnings : list of str
+    """
+
+    frequency: float
+    period: int
+    impacts_per_period: float
+    strobe: np.ndarray
+    strobe_velocity: np.ndarray
+    times: np.ndarray
+    max: float
+    min: float
+    mismatch: float
+    point: float
+    window: tuple[float, float]
+    result: Any = field(repr=False)
+    settled_after: int = 0
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        """True when a period was found."""
+        return self.period > 0
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain numbers for JSON output."""
+        return {
+            "frequency": self.frequency, "period": self.period, "impacts_per_period": self.impacts_per_period,
+            "strobe": [float(v) for v in self.strobe], "max": self.max, "min": self.min,
+            "mismatch": self.mismatch, "warnings": list(self.warnings),
+        }
+
+
+def count(name: str, value: Any, minimum: int) -> int:
+    """An integer >= ``minimum``; ParameterError naming ``name`` otherwise."""
+    from ..exceptions import ParameterError
+
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or int(value) < minimum:
+        raise ParameterError(f"{name}: expected a whole number >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def harmonic_period(scenario: Scenario) -> float:
+    """The forcing period ``1/f`` [s]; ScenarioError unless the load is harmonic."""
+    ex = scenario.excitation
+    if ex.kind == "none" or ex.shape != "harmonic" or ex.frequency is None:
+        raise ScenarioError(
+            'excitation.shape: steady-state analysis needs a harmonic load (shape = "harmonic" with a '
+            f"frequency), got kind = {ex.kind!r}, shape = {ex.shape!r}",
+            key="excitation.shape",
+        )
+    return 1.0 / float(ex.frequency)
+
+
+def strobe_point(scenario: Scenario) -> float:
+    """Where the strobe samples ``w``: the first contactor, else the first output point [m]."""
+    if scenario.contactors:
+        return float(scenario.contactors[0].position)
+    return float(scenario.output_points[0])
+
+
+def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
+                  max_period: int | None = None) -> tuple[int, float]:
+    """Smallest period of a sequence of strobe states.
+
+    Parameters
+    ----------
+    samples : ndarray, (n_samples, n_components)
+        Already scaled (each component of order one over the record).
+    tolerance : float
+        Largest mismatch ``max_k |s_{k+n} - s_k|`` accepted.
+    max_period : int, optional
+        Largest period tried; default ``(n_samples - 1) // 2``.
+
+    Returns
+    -------
+    (period, mismatch)
+        ``period`` 0 when none passed; ``mismatch`` of the period found, else
+        the smallest over the candidates.
+    """
+    s = np.asarray(samples, dtype=float)
+    if s.ndim == 1:
+        s = s[:, None]
+    top = (s.shape[0] - 1) // 2 if max_period is None else min(int(max_period), s.shape[0] - 1)
+    best = math.inf
+    for n in range(1, max(top, 0) + 1):
+        mism = float(np.max(np.abs(s[n:] - s[:-n]))) if s.shape[0] > n else math.inf
+        if mism <= tolerance:
+            return n, mism
+        best = min(best, mism)
+    return 0, best
+
+
+def still_settling(samples: np.ndarray, period: int, tolerance: float) -> bool:
+    """Whether a shorter period than ``period`` (or 1 when none) is being approached.
+
+    True when for some ``m`` below ``period`` (all ``m`` up to a quarter of
+    the record when ``period`` is 0) the mismatch ``|s_{k+m} - s_k|`` over the
+    second half of the record is less than half of that over the first half
+    and still above ``tolerance``: a decaying transient, which aliased by the
+    strobe can pass for a longer period.
+    """
+    s = np.asarray(samples, dtype=float)
+    top = period - 1 if period else max(1, (s.shape[0] - 1) // 4)
+    for m in range(1, top + 1):
+        d = np.max(np.abs(s[m:] - s[:-m]), axis=1)
+        h = d.size // 2
+        if h < 2:
+            break
+        early, late = float(np.max(d[:h])), float(np.max(d[h:]))
+        if early > tolerance and late < 0.5 * early:
+            return True
+    return False
+
+
+def _probe_points(scenario: Scenario) -> np.ndarray:
+    """Contactors, output points and five stations along the beam."""
+    L = scenario.beam.length
+    pts = [c.position for c in scenario.contactors] + list(scenario.output_points)
+    pts += list(np.linspace(0.2, 1.0, 5) * L)
+    return np.unique(np.asarray(pts, dtype=float))
+
+
+def _scaled(w: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Displacements and velocities each divided by the largest magnitude of their group."""
+    sw = float(np.max(np.abs(w))) or 1.0
+    sv = float(np.max(np.abs(v))) or 1.0
+    return np.hstack([w / sw, v / sv])
+
+
+def analyse_steady_state(
+    result: SimulationResult,
+    scenario: Scenario,
+    *,
+    settle_periods: int,
+    record_periods: int,
+    tolerance: float = PERIOD_TOLERANCE,
+    max_period: int | None = None,
+    start: float | None = None,
+    settled_after: int | None = None,
+) -> SteadyState:
+    """Strobe samples, period and extremes of the record of a finished run.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        A run of ``settle_periods + record_periods`` forcing periods from ``start``.
+    scenario : Scenario
+        Its scenario (harmonic load).
+    settle_periods, record_periods : int
+        Periods discarded, then recorded.
+    tolerance : float
+        Relative tolerance of the period test.
+    max_period : int, optional
+        Longest period looked for (default ``record_periods // 2``).
+    start : float, optional, [s]
+        When the harmonic load begins in this run (default ``excitation.start``).
+    settled_after : int, optional
+        Periods run before the record in all (default ``settle_periods``).
+
+    Returns
+    -------
+    SteadyState
+    """
+    T = harmonic_period(scenario)
+    t_load = scenario.excitation.start if start is None else float(start)
+    sol = result.solution
+    k = np.arange(settle_periods, settle_periods + record_periods + 1)
+    times = np.minimum(t_load + k * T, sol.t_end)
+    probes = _probe_points(scenario)
+    smp = sol.sample(probes, times)
+    x0 = strobe_point(scenario)
+    at = sol.sample(np.array([x0]), times)
+    lo, hi = float(times[0]), float(times[-1])
+    warns: list[str] = []
+    if result.status != 0:
+        warns.append(f"the run stopped early ({result.message}); the steady state is incomplete")
+    scaled = _scaled(smp.w, smp.w_t)
+    n, mism = detect_period(scaled, tolerance, max_period)
+    before = settle_periods if settled_after is None else settled_after
+    settling = still_settling(scaled, n, tolerance)
+    free = not smp.engaged.any() and not any(lo <= e.time <= hi for e in result.events)
+    if free and n > 1:  # no contact over the record: a linear system, whose steady state has period 1
+        settling = True
+    if settling:
+        n = 0
+    n_imp = sum(1 for e in result.events if e.kind == "impact" and lo <= e.time < hi)
+    if n:
+        reps = record_periods // n
+        in_reps = sum(1 for e in result.events if e.kind == "impact" and lo <= e.time < lo + reps * n * T)
+        ipp = in_reps / reps
+    else:
+        ipp = n_imp / record_periods
+        top = max_period if max_period is not None else record_periods // 2
+        why = ("the strobe samples are still converging (a decaying transient)" if settling else
+               "chaotic or quasi-periodic motion, or not settled")
+        warns.append(
+            f"no period up to {top} forcing periods within tolerance {tolerance:g} at f = {1 / T:.6g} Hz "
+            f"(smallest mismatch {mism:.3g}): {why} after {before} periods; "
+            "impacts_per_period is the mean per forcing period"
+        )
+    ext = sol.extrema([(x0, lo, hi, 1.0, 0.0, None), (x0, lo, hi, -1.0, 0.0, None)])
+    return SteadyState(
+        frequency=1.0 / T, period=n, impacts_per_period=float(ipp), strobe=at.w[:-1, 0].copy(),
+        strobe_velocity=at.w_t[:-1, 0].copy(), times=times[:-1].copy(), max=float(ext[0, 0]),
+        min=float(-ext[1, 0]), mismatch=float(mism), point=x0, window=(lo, hi), result=result,
+        settled_after=before, warnings=warns,
+    )
+
+
+def run_periods(scenario: Scenario, periods: int, *, start_state: ModalState | None = None,
+                progress: Callable[[float], None] | None = None) -> tuple[SimulationResult, float]:
+    """Simulate ``periods`` forcing periods from the load's start; the run and the load's start time.
+
+    From ``start_state`` the run begins at t = 0 with the load switched on
+    at once (``start`` = 0, same ``phase``): the state came from the end of a
+    run that ended a whole number of periods after its load began, so the
+    phase of the load carries on.
+    """
+    from ..solver import simulate
+
+    T = harmonic_period(scenario)
+    ex = scenario.excitation
+    if start_state is not None and ex.start != 0.0:
+        ex = dataclasses.replace(ex, start=0.0)
+    end = ex.start + periods * T
+    sc = dataclasses.replace(scenario, excitation=ex, solver=dataclasses.replace(scenario.solver, end_time=end))
+    return simulate(sc, start=start_state, progress=progress), ex.start
+
+
+def steady_state(
+    scenario: Scenario,
+    *,
+    settle_periods: int = 100,
+    record_periods: int = 50,
+    start_state: ModalState | None = None,
+    tolerance: float = PERIOD_TOLERANCE,
+    max_period: int | None = None,
+    max_settle_periods: int | None = None,
+) -> SteadyState:
+    """Run a harmonically forced scenario to its steady state and analyse it.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        With ``[excitation] shape = "harmonic"``; ``solver.end_time`` is
+        replaced by ``start + (settle_periods + record_periods) / f``.
+    settle_periods, record_periods : int
+        Forcing periods discarded as transient, then recorded.
+    start_state : ModalState, optional
+        Begin from this state (e.g. ``previous.result.final_state()``) with the
+        load on from t = 0, instead of the scenario's initial condition.
+    tolerance : float
+        Relative tolerance of the period test (module docstring).
+    max_period : int, optional
+        Longest period looked for (default ``record_periods // 2``).
+    max_settle_periods : int, optional
+        When no period is found, the run goes on from its final state for
+        ``settle_periods + record_periods`` more periods, and again, until a
+        period is found or this many periods have settled (default
+        ``10 * settle_periods``; a lightly damped beam forced off resonance
+        keeps its free transient for hundreds of periods).
+
+    Returns
+    -------
+    SteadyState
+        With ``period = 0`` and a warning when no period was found.
+
+    Examples
+    --------
+    >>> ss = steady_state(sc, settle_periods=100, record_periods=50)  # doctest: +SKIP
+    >>> ss.period, ss.impacts_per_period, ss.strobe[:2]               # doctest: +SKIP
+    """
+    settle = count("settle_periods", settle_periods, 0)
+    record = count("record_periods", record_periods, 2)
+    limit = 10 * settle if max_settle_periods is None else count("max_settle_periods", max_settle_periods, 0)
+    ss = settle_and_record(scenario, settle, record, start_state, tolerance, max_period, limit)
+    for text in ss.warnings:
+        emit_user_level_warning(text)
+    return ss
+
+
+def settle_and_record(scenario: Scenario, settle: int, record: int, start_state: ModalState | None,
+                      tolerance: float, max_period: int | None, limit: int) -> SteadyState:
+    """Run, analyse, and extend the run while no period is found (see :func:`steady_state`)."""
+    res, t_load = run_periods(scenario, settle + record, start_state=start_state)
+    done = settle
+    while True:
+        ss = analyse_steady_state(res, scenario, settle_periods=settle, record_periods=record, tolerance=tolerance,
+                                  max_period=max_period, start=t_load, settled_after=done)
+        if ss.period or res.status != 0 or done + settle + record > limit:
+            return ss
+        res, t_load = run_periods(scenario, settle + record, start_state=res.final_state())
+        done += settle + record

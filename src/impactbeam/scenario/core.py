@@ -1,0 +1,254 @@
+"""The validated scenario: :class:`Scenario`, :func:`parse_scenario` and :func:`load_scenario`."""
+
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .._warnings import emit_user_level_warning
+from ..model.beam import Beam, Contactor
+from ..exceptions import ScenarioError
+from ..model.loading import Excitation, InitialCondition
+from ..model import Damping, SolverOptions
+from .edit import _normalise, scenario_toml, set_path
+from .checks import check_magnitudes, warn_numeric_strings
+from .fields import _string
+from .parse_run import (
+    _parse_damping,
+    _parse_excitation,
+    _parse_initial,
+    _parse_output,
+    _parse_output_fields,
+    _parse_solver,
+)
+from .parse_structure import _parse_beam, _parse_contactors
+from .schema import _SCHEMA, _check_structure
+
+__all__ = ["Scenario", "load_scenario", "parse_scenario"]
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A validated simulation case (see the scenario reference).
+
+    Attributes
+    ----------
+    beam : Beam
+    contactors : tuple of Contactor
+    damping : Damping
+    excitation : Excitation
+    initial : InitialCondition
+    solver : SolverOptions
+    output_points : tuple of float, [m]
+        Where the response is recorded; default: the contactor positions,
+        then the right end (without repeats).
+    data : dict
+        The normalised raw mapping (a private deep copy): vary a dotted path
+        with :func:`set_path` / :meth:`with_values` and re-parse.
+    source : Path or None
+        The file the scenario came from.
+    base_dir : Path or None
+        Directory against which relative file names (trace CSV) are resolved.
+    name : str
+        ``name`` from the file, else the file stem.
+    output_fields : tuple of str
+        Fields of result files (``[output] fields``, canonical names):
+        ``displacement`` and ``velocity`` (always written), ``moment`` and
+        ``stress`` (which also adds its maximum to the metrics).
+    """
+
+    beam: Beam
+    contactors: tuple[Contactor, ...]
+    damping: Damping
+    excitation: Excitation
+    initial: InitialCondition
+    solver: SolverOptions
+    output_points: tuple[float, ...]
+    data: dict[str, Any] = field(repr=False)
+    source: Path | None = None
+    base_dir: Path | None = None
+    name: str = "scenario"
+    output_fields: tuple[str, ...] = ()
+
+    def to_toml(self) -> str:
+        """The scenario as TOML text (``load_scenario`` of it gives the same scenario)."""
+        return scenario_toml(self.data)
+
+    @property
+    def description(self) -> str | None:
+        """The ``description`` string of the file, if any."""
+        return self.data.get("description")
+
+    def _repr_html_(self) -> str:
+        """Compact summary table for Jupyter."""
+        from .._html import scenario_html
+
+        return scenario_html(self)
+
+    def with_values(self, values: Mapping[str, Any]) -> Scenario:
+        """A new scenario with the dotted paths in ``values`` set, re-validated.
+
+        >>> sc2 = sc.with_values({"contactors.0.gap": "0.432 mm", "solver.modes": 12})  # doctest: +SKIP
+
+        Raises :class:`ScenarioError` for an unknown path or an invalid value
+        (the message starts with the dotted key).
+
+        Parameters
+        ----------
+        values : mapping of str to value
+            Dotted path -> new value (SI number, string with units, list; None removes
+            the key).
+        """
+        data: dict[str, Any] = self.data
+        for path, value in values.items():
+            data = set_path(data, path, value)
+        return parse_scenario(data, base_dir=self.base_dir, source=self.source, name=self.name)
+
+
+def parse_scenario(
+    data: Mapping[str, Any],
+    *,
+    base_dir: str | os.PathLike[str] | None = None,
+    source: str | os.PathLike[str] | None = None,
+    name: str = "scenario",
+) -> Scenario:
+    """Validate a scenario mapping (the TOML schema of the scenario reference).
+
+    Parameters
+    ----------
+    data : mapping
+        Tables ``beam`` (required), ``supports``, ``contactors`` (list),
+        ``damping``, ``excitation``, ``initial``, ``solver``, ``output`` and
+        the strings ``name`` and ``description``. Values are SI numbers or
+        strings with units. ``None`` values count as absent.
+    base_dir : path-like, optional
+        Directory for relative file names (``excitation.file``); default: the
+        current directory.
+    source : path-like, optional
+        The file ``data`` came from (recorded in the result).
+    name : str
+        Name used when ``data`` has no ``name``.
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    ScenarioError
+        Naming the dotted key of the first problem found.
+    """
+    if not isinstance(data, Mapping):
+        raise ScenarioError(f"a scenario must be a mapping of tables, got {type(data).__name__}")
+    raw = _normalise(data)
+    _check_structure(raw, _SCHEMA, "", raw)
+    check_magnitudes(raw)
+    warn_numeric_strings(raw)
+    if "name" in raw:
+        name = _string("name", raw["name"])
+    if "description" in raw:
+        _string("description", raw["description"])
+    base = Path(base_dir) if base_dir is not None else None
+
+    beam = _parse_beam(raw)
+    contactors = _parse_contactors(raw, beam)
+    damping = _parse_damping(raw)
+    excitation = _parse_excitation(raw, beam, base)
+    initial = _parse_initial(raw, beam)
+    solver = _parse_solver(raw)
+    points = _parse_output(raw, beam, contactors)
+    scenario = Scenario(
+        beam=beam,
+        contactors=contactors,
+        damping=damping,
+        excitation=excitation,
+        initial=initial,
+        solver=solver,
+        output_points=points,
+        data=raw,
+        source=Path(source) if source is not None else None,
+        base_dir=base,
+        name=name,
+        output_fields=_parse_output_fields(raw),
+    )
+    warn_unusual(scenario)
+    return scenario
+
+
+def load_scenario(path: str | os.PathLike[str]) -> Scenario:
+    """Read and validate a scenario TOML file.
+
+    Relative file names inside it (``excitation.file``) are resolved against
+    the file's directory; the scenario's name is its ``name`` or the file stem.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A ``.toml`` scenario file.
+
+    Raises
+    ------
+    ScenarioError
+        For a missing or unreadable file, a TOML syntax error (with the
+        parser's line and column) or invalid content.
+    """
+    if not str(path).strip():
+        raise ScenarioError("cannot read scenario: the path is empty; give a scenario file (.toml)")
+    p = Path(path)
+    try:
+        text = p.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise ScenarioError(f'cannot read scenario "{path}": file not found') from None
+    except IsADirectoryError:
+        raise ScenarioError(f'cannot read scenario "{path}": it is a directory, not a scenario file (.toml)') from None
+    except UnicodeDecodeError:
+        raise ScenarioError(f'cannot read scenario "{path}": not UTF-8 text') from None
+    except OSError as exc:
+        raise ScenarioError(f'cannot read scenario "{path}": {exc.strerror or exc}') from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f'"{path}": invalid TOML: {exc}') from None
+    resolved = p.resolve()
+    return parse_scenario(data, base_dir=resolved.parent, source=resolved, name=p.stem)
+
+
+def warn_unusual(sc: Scenario) -> None:
+    """Warn (ImpactBeamWarning) for valid inputs that are very likely mistakes.
+
+    * ``initial.modal_displacement`` / ``modal_velocity`` with more entries
+      than ``solver.modes``: the extra entries are ignored by the solver;
+    * an excitation that starts at or after ``solver.end_time``: it never acts;
+    * a contactor at an end whose translational support is rigid (clamped or
+      pinned): ``w = 0`` there, so it can never engage (or, with gap 0, is
+      always at the contact surface with no force).
+    """
+    n = sc.solver.modes
+    for name in ("modal_displacement", "modal_velocity"):
+        values = getattr(sc.initial, name)
+        if values is not None and len(values) > n:
+            emit_user_level_warning(
+                f"initial.{name}: {len(values)} entries but solver.modes = {n}; the entries beyond mode {n} "
+                f"are ignored (raise solver.modes to {len(values)} to use them)"
+            )
+    ex = sc.excitation
+    if ex.kind != "none":
+        first = ex.start + (float(ex.times[0]) if ex.shape == "table" and ex.times is not None else 0.0)
+        if first >= sc.solver.end_time:
+            key = "excitation.start" if ex.shape != "table" or ex.start >= sc.solver.end_time else "excitation.file"
+            emit_user_level_warning(
+                f"{key}: the excitation starts at {first:g} s, at or after solver.end_time = "
+                f"{sc.solver.end_time:g} s; it never acts in this run"
+            )
+    for i, c in enumerate(sc.contactors):
+        for end, x, support in (("left", 0.0, sc.beam.left), ("right", sc.beam.length, sc.beam.right)):
+            if abs(c.position - x) <= 1e-12 * sc.beam.length and math.isinf(support.translational):
+                emit_user_level_warning(
+                    f"contactors.{i}.position: at the {end} end, which is {support.describe()} (w = 0 there); "
+                    "the contactor can never act"
+                )

@@ -1,0 +1,386 @@
+"""Running a sweep: in process or on Dask, batches written as they finish, signals handled between writes."""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+import numpy as np
+
+from .._optional import require
+from ..exceptions import ImpactBeamError, ParameterError, SimulationError
+if TYPE_CHECKING:
+    import xarray as xr
+from .cluster import dask_client
+from .batches import (
+    _Batch,
+    _chunk_shape,
+    _error_message,
+    _make_batch,
+    _regions,
+    default_batch_size,
+    run_batch,
+)
+from .parse import load_sweep, parse_sweep
+from .spec import FAILED, NOT_RUN, SweepSpec
+from .store import _StoreLock, _create_store, _open_existing
+
+log = logging.getLogger(__name__)
+
+__all__ = ["SweepInterrupted", "SweepRun", "run_sweep", "sweep"]
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """The sweep was stopped by a signal (SIGINT or SIGTERM) between two writes.
+
+    The store holds every batch finished so far; run the same sweep again to
+    finish the rest. ``signum`` is the signal number.
+    """
+
+    def __init__(self, signum: int, done: int = 0, total: int = 0) -> None:
+        super().__init__(f"interrupted by signal {signum}")
+        self.signum = signum
+        self.done = done
+        self.total = total
+
+
+@dataclass
+class SweepRun:
+    """Outcome of :func:`run_sweep`.
+
+    Attributes
+    ----------
+    dataset : xarray.Dataset
+        The results (lazily read from the store, or in memory without ``out``).
+    n_cases, computed, skipped, failed : int
+        All cases; cases run now; cases already done in the store (resume);
+        cases that failed in this run.
+    out : Path or None
+    """
+
+    dataset: Any
+    n_cases: int
+    computed: int
+    skipped: int
+    failed: int
+    out: Path | None
+
+
+class _SignalGuard:
+    """Turn SIGINT/SIGTERM into SweepInterrupted, but never in the middle of a write."""
+
+    def __init__(self) -> None:
+        self.critical = False
+        self.pending: int | None = None
+        self.previous: dict[int, Any] = {}
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        if self.critical:
+            self.pending = signum
+        else:
+            raise SweepInterrupted(signum)
+
+    def __enter__(self) -> _SignalGuard:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self.previous[sig] = signal.signal(sig, self._handler)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        for sig, handler in self.previous.items():
+            signal.signal(sig, handler)
+
+    def write(self) -> _Critical:
+        return _Critical(self)
+
+
+class _Critical:
+    def __init__(self, guard: _SignalGuard) -> None:
+        self.guard = guard
+
+    def __enter__(self) -> None:
+        self.guard.critical = True
+
+    def __exit__(self, exc_type: Any, *rest: Any) -> None:
+        self.guard.critical = False
+        if exc_type is None and self.guard.pending is not None:
+            raise SweepInterrupted(self.guard.pending)
+
+
+class _Writer:
+    """Writes finished batches into the store's chunks (status last)."""
+
+    def __init__(self, store: Any, spec: SweepSpec) -> None:
+        zarr = require("zarr", "sweep")
+
+        self.group = zarr.open_group(store, mode="r+")
+        self.arrays = {name: self.group[name] for name in (*spec.metrics, "message", "status")}
+        if spec.histories is not None:
+            self.arrays["w"] = self.group["w"]
+
+    def write(self, region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
+        sl = tuple(slice(a, b) for a, b in region)
+        shape = tuple(b - a for a, b in region)
+        for name, arr in self.arrays.items():
+            if name == "status":
+                continue
+            value = res[name]
+            if name == "message":
+                value = np.array(value, dtype=np.dtypes.StringDType())
+            value = np.asarray(value).reshape(shape + np.shape(value)[1:])
+            arr[sl] = value
+        self.arrays["status"][sl] = np.asarray(res["status"], dtype=np.int8).reshape(shape)
+
+    def status(self) -> np.ndarray:
+        return self.arrays["status"][...]
+
+
+def run_sweep(
+    spec_or_path: SweepSpec | str | os.PathLike[str] | Mapping[str, Any],
+    out: str | os.PathLike[str] | None = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    batch_size: int | None = None,
+    progress: bool = True,
+    on_error: Literal["record", "raise"] = "record",
+) -> SweepRun:
+    """Run (or resume) a sweep; like :func:`sweep` but returns a :class:`SweepRun` with counts.
+
+    Parameters
+    ----------
+    spec_or_path : SweepSpec, path or mapping
+        The sweep.
+    out : str or path-like, optional
+        Zarr store to create or resume (None: in memory).
+    workers : int, optional
+        Processes of a local Dask cluster (0: in this process).
+    scheduler : str, optional
+        Address of a running Dask scheduler.
+    batch_size : int, optional
+        Cases per batch (one Zarr chunk).
+    progress : bool
+        Show a progress bar on stderr.
+    on_error : {"record", "raise"}
+        Record a failed case (status -1) or raise.
+    """
+    for name in ("zarr", "dask", "distributed"):  # before any work: one clear message
+        require(name, "sweep", feature="parameter sweeps")
+    spec = _as_spec(spec_or_path)
+    if on_error not in ("record", "raise"):
+        raise ParameterError(f'on_error: must be "record" or "raise", got {on_error!r}')
+    if workers is not None and scheduler is not None:
+        raise ParameterError("give either workers (a local cluster) or scheduler (a running one), not both")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
+        raise ParameterError(f"workers: must be an integer >= 0, got {workers!r}")
+    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
+        raise ParameterError(f"batch_size: must be a positive integer, got {batch_size!r}")
+    out_path = Path(out) if out is not None else None
+    chunk = _chunk_shape(spec, batch_size or default_batch_size(spec.n_cases))
+    if out_path is None:
+        _check_in_memory(spec)
+    if out_path is not None and not out_path.parent.is_dir():
+        raise ParameterError(f'--out: directory "{out_path.parent}" does not exist')
+    with _StoreLock(out_path):
+        return _run_locked(spec, out_path, chunk, workers, scheduler, progress, on_error)
+
+
+def _check_in_memory(spec: SweepSpec) -> None:
+    """Refuse, before any work, an in-memory result larger than the memory limit."""
+    from .._memory import check_memory
+
+    per_case = 8 * len(spec.metrics) + 40
+    if spec.histories is not None:
+        per_case += 8 * spec.history_times().size * len(spec.histories.points)
+    check_memory(per_case * spec.n_cases, f"an in-memory sweep of {spec.n_cases} cases",
+                 "write it to a store (out=...), or sweep fewer cases or histories")
+
+
+def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], workers: int | None,
+                scheduler: str | None, progress: bool, on_error: str) -> SweepRun:
+    """:func:`run_sweep` once the store is ours."""
+    fresh = not (out_path is not None and out_path.exists()
+                 and not (out_path.is_dir() and not any(out_path.iterdir())))
+    store = _create_store(spec, out_path, chunk) if fresh else _open_existing(spec, out_path)  # type: ignore[arg-type]
+    writer = _Writer(store, spec)
+    chunk = tuple(writer.arrays["status"].chunks)  # the store's layout wins on resume
+    # a new store has run nothing: no need to read its (possibly millions of) status chunks
+    status = np.full(spec.shape, NOT_RUN, dtype=np.int8) if fresh else writer.status()
+    regions = (r for r in _regions(spec.shape, chunk) if (status[r] == NOT_RUN).any())  # lazily
+    skipped = int((status != NOT_RUN).sum())
+    n_todo = spec.n_cases - skipped
+    counts = {"computed": 0, "failed": 0}
+
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=spec.n_cases, initial=spec.n_cases - n_todo, desc="sweep", unit="case",
+               file=sys.stderr, disable=not progress, dynamic_ncols=True)
+
+    def done(region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
+        with guard.write():
+            writer.write(region, res)
+        n = len(res["status"])
+        counts["computed"] += n
+        counts["failed"] += int((np.asarray(res["status"]) == FAILED).sum())
+        bar.update(n)
+
+    try:
+        with _SignalGuard() as guard:
+            if n_todo:
+                batches = (_make_batch(spec, r, on_error) for r in regions)
+                try:
+                    if workers == 0:
+                        for b in batches:
+                            done(b.region, run_batch(b))
+                    else:
+                        _run_dask(batches, done, workers=workers, scheduler=scheduler, on_error=on_error)
+                except SweepInterrupted as exc:
+                    exc.done = spec.n_cases - n_todo + counts["computed"]
+                    exc.total = spec.n_cases
+                    raise
+    finally:
+        bar.close()
+    log.info("sweep %s: %d cases, %d computed, %d already done, %d failed",
+             spec.name, spec.n_cases, counts["computed"], skipped, counts["failed"])
+    import xarray as xr
+
+    if out_path is not None:
+        import warnings
+
+        zarr = require("zarr", "sweep")
+
+        # consolidated metadata lets xr.open_zarr(path) open the finished store without a
+        # warning; zarr 3 notes (ZarrUserWarning) that it is an extension of its format 3
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Consolidated metadata", category=UserWarning)
+            zarr.consolidate_metadata(store)
+    ds = xr.open_zarr(store, consolidated=False, chunks=None)
+    order = [*spec.metrics, "status", "message", *(["w"] if spec.histories is not None else [])]
+    ds = ds[order]  # the store lists its arrays in no particular order
+    if out_path is None:
+        ds = ds.load()
+    return SweepRun(ds, spec.n_cases, counts["computed"], skipped, counts["failed"], out_path)
+
+
+def _run_dask(
+    batches: Iterator[_Batch], done: Any, *, workers: int | None, scheduler: str | None, on_error: str = "record"
+) -> None:
+    """Run the batches on a Dask cluster; ``done(region, result)`` as each finishes."""
+    as_completed = require("distributed", "sweep").as_completed
+    futures: list[Any] = []
+    with dask_client(workers, scheduler) as client:
+        try:
+            # a bounded window of batches in flight: a sweep of any size starts at once, and
+            # an interrupt has only a few tasks to cancel
+            window = 4 * max(1, len(client.scheduler_info().get("workers", {})) or (workers or 1))
+            pending = iter(batches)
+            region_of: dict[Any, Any] = {}
+
+            def submit() -> Any:
+                b = next(pending, None)
+                if b is None:
+                    return None
+                fut = client.submit(run_batch, b, pure=False)
+                region_of[fut.key] = b.region
+                futures.append(fut)
+                return fut
+
+            first = [f for f in (submit() for _ in range(window)) if f is not None]
+            queue = as_completed(first, with_results=True)
+            for fut, res in queue:
+                done(region_of.pop(fut.key), res)
+                fut.release()
+                futures.remove(fut)
+                nxt = submit()
+                if nxt is not None:
+                    queue.add(nxt)
+        except (ImpactBeamError, SweepInterrupted):
+            raise
+        except Exception as exc:
+            # run_batch records every case's own error, so this is the cluster's
+            # (a worker died, impactbeam missing on a worker): nothing is stored for it
+            if on_error == "raise":
+                raise
+            raise SimulationError(
+                f"a batch failed on the Dask cluster ({_error_message(exc)}); the finished batches "
+                "are stored: run the same sweep again to retry the rest"
+            ) from exc
+        finally:
+            if futures:
+                client.cancel(futures)
+
+
+def _as_spec(spec_or_path: Any) -> SweepSpec:
+    if isinstance(spec_or_path, SweepSpec):
+        return spec_or_path
+    if isinstance(spec_or_path, Mapping):
+        return parse_sweep(spec_or_path)
+    return load_sweep(spec_or_path)
+
+
+def sweep(
+    spec_or_path: SweepSpec | str | os.PathLike[str] | Mapping[str, Any],
+    out: str | os.PathLike[str] | None = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    batch_size: int | None = None,
+    progress: bool = True,
+    on_error: Literal["record", "raise"] = "record",
+) -> xr.Dataset:
+    """Run a parameter study and return its labelled results.
+
+    Parameters
+    ----------
+    spec_or_path : SweepSpec, path or mapping
+        A sweep file (TOML, see the module docstring), its parsed mapping or a
+        :class:`SweepSpec`.
+    out : path, optional
+        Zarr store (a directory). Created with every case "not yet run" and
+        filled as batches finish; if it exists and was made by the same sweep,
+        only the missing cases run (resume). Without ``out`` the results are
+        kept in memory.
+    workers : int, optional
+        Worker processes of a local ``dask.distributed`` cluster (one thread
+        each); default all cores. ``0`` runs the cases in this process,
+        without Dask.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``) whose
+        workers run the cases (they need ``impactbeam`` installed and the
+        scenario's files at the same paths).
+    batch_size : int, optional
+        Cases per task (= per Zarr chunk); default :func:`default_batch_size`.
+        A resumed store keeps its own batches.
+    progress : bool
+        Progress bar on stderr (tqdm).
+    on_error : {"record", "raise"}
+        ``record``: a case that fails gets status -1, its error in ``message``
+        and NaN metrics, and the sweep goes on; ``raise``: the first failure
+        stops the sweep.
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per grid parameter (named by its path) or ``case``;
+        metric variables (``units`` in their attributes), ``status``,
+        ``message`` and optional ``w`` histories.
+
+    Raises
+    ------
+    ScenarioError
+        For an invalid sweep file (one line naming the key).
+    ParameterError
+        For ``out`` made by a different sweep, or bad arguments.
+    SweepInterrupted
+        On SIGINT / SIGTERM; the store keeps every finished batch.
+    """
+    return run_sweep(
+        spec_or_path, out, workers=workers, scheduler=scheduler, batch_size=batch_size,
+        progress=progress, on_error=on_error,
+    ).dataset

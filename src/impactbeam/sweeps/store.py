@@ -1,0 +1,202 @@
+"""The Zarr store of a sweep: created from metadata, reopened to resume, guarded by one writer's lock."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+import numpy as np
+
+from .._io import pid_alive
+from .._optional import require
+from ..exceptions import ParameterError
+from ..metrics import METRIC_UNITS
+if TYPE_CHECKING:
+    import xarray as xr
+from .spec import NOT_RUN, STATUS_CODES, SweepSpec
+
+__all__ = []
+
+
+def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict[str, Any]]:
+    """The empty result (every case not run) as a lazy Dataset, and its Zarr encoding.
+
+    Each variable is one lazy dask chunk (never computed: only the metadata
+    is written), so a sweep of millions of cases starts at once; the Zarr
+    encoding sets the on-disk chunks, one per batch.
+    """
+    da = require("dask.array", "sweep")
+    import xarray as xr
+
+    from .. import __version__
+
+    S = np.dtypes.StringDType()
+    shape, dims = spec.shape, spec.dims
+    coords: dict[str, Any] = {}
+    if spec.is_grid:
+        for p in spec.parameters:
+            vals = list(p.values or ())
+            arr = np.array(vals, dtype=S) if isinstance(vals[0], str) else np.array(vals)
+            attrs = {"long_name": p.path}
+            if p.units is not None:
+                attrs["units"] = p.units
+            coords[p.path] = xr.Variable((p.path,), arr, attrs)
+    else:
+        coords["case"] = xr.Variable(("case",), np.arange(shape[0], dtype=np.int64), {"long_name": "case number"})
+        x = spec.sample_values()
+        for j, p in enumerate(spec.parameters):
+            attrs = {"long_name": p.path, "distribution": p.distribution or "", "distribution_args": list(p.args)}
+            if p.units is not None:
+                attrs["units"] = p.units
+            coords[p.path] = xr.Variable(("case",), x[:, j].copy(), attrs)
+    data: dict[str, Any] = {}
+    enc: dict[str, Any] = {}
+    for m in spec.metrics:
+        data[m] = xr.Variable(dims, da.full(shape, np.nan, chunks=-1), {"units": METRIC_UNITS[m], "long_name": m.replace("_", " ")})
+        enc[m] = {"chunks": chunk, "fill_value": np.nan}
+    data["status"] = xr.Variable(
+        dims,
+        da.full(shape, NOT_RUN, dtype=np.int8, chunks=-1),
+        {
+            "long_name": "case status",
+            "flag_values": list(STATUS_CODES),
+            "flag_meanings": " ".join(v.replace(" ", "_") for v in STATUS_CODES.values()),
+        },
+    )
+    enc["status"] = {"chunks": chunk, "fill_value": NOT_RUN}
+    data["message"] = xr.Variable(dims, da.full(shape, "", dtype=S, chunks=-1), {"long_name": "error or solver message"})
+    enc["message"] = {"chunks": chunk}
+    if spec.histories is not None:
+        t = spec.history_times()
+        pts = np.array(spec.histories.points)
+        coords["time"] = xr.Variable(("time",), t, {"units": "s", "long_name": "time"})
+        coords["point"] = xr.Variable(("point",), pts, {"units": "m", "long_name": "x of the output point"})
+        hchunk = (*chunk, t.size, pts.size)
+        data["w"] = xr.Variable(
+            (*dims, "time", "point"),
+            da.full((*shape, t.size, pts.size), np.nan, chunks=-1),
+            {"units": "m", "long_name": "deflection w(x, t)"},
+        )
+        enc["w"] = {"chunks": hchunk, "fill_value": np.nan}
+    c0 = spec.base.contactors[0] if spec.base.contactors else None
+    where = (
+        "u at the first contactor, positive away from it (u = -w for a contactor above the beam)"
+        if c0 is not None
+        else "u = w at the first output point"
+    )
+    attrs = {
+        "title": f"impactbeam sweep {spec.name!r} of scenario {spec.base.name!r}",
+        "design": spec.design,
+        "n_cases": spec.n_cases,
+        "sweep_hash": spec.hash,
+        "sweep": spec.canonical_json,
+        "metrics_of": where,
+        "status_codes": "; ".join(f"{k}: {v}" for k, v in STATUS_CODES.items()),
+        "impactbeam_version": __version__,
+    }
+    if not spec.is_grid:
+        attrs["seed"] = int(spec.seed or 0)
+        attrs["samples"] = int(spec.samples or 0)
+    return xr.Dataset(data, coords, attrs), enc
+
+
+def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> Any:
+    """Write the empty store (metadata and coordinates); atomic for a directory."""
+    ds, enc = _template(spec, chunk)
+    if out is None:
+        zarr = require("zarr", "sweep")
+
+        store = zarr.storage.MemoryStore()
+        ds.to_zarr(store, compute=False, encoding=enc, consolidated=False)
+        return store
+    tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    try:
+        ds.to_zarr(str(tmp), compute=False, encoding=enc, consolidated=False)
+        if out.exists():  # an empty directory
+            out.rmdir()
+        os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return str(out)
+
+
+def _open_existing(spec: SweepSpec, out: Path) -> Any:
+    """Open a store made by the same sweep, else raise ParameterError."""
+    zarr = require("zarr", "sweep")
+
+    try:
+        group = zarr.open_group(str(out), mode="r")
+        attrs = dict(group.attrs)
+    except Exception:
+        raise ParameterError(
+            f'--out: "{out}" exists and is not a sweep result; choose another path or remove it'
+        ) from None
+    found = attrs.get("sweep_hash")
+    if found is None or "status" not in group:
+        raise ParameterError(f'--out: "{out}" exists and is not a sweep result; choose another path or remove it')
+    if found != spec.hash:
+        raise ParameterError(
+            f'--out: "{out}" holds the results of a different sweep (hash {str(found)[:12]}, this sweep '
+            f"{spec.hash[:12]}); choose another path or remove it"
+        )
+    return str(out)
+
+
+class _StoreLock:
+    """One writer per store: a lock file beside it with the holder's pid, host and start time.
+
+    A second run on the same store is refused with the holder's identity; a lock
+    left by a process of this host that no longer exists (killed) is stale and
+    is taken over.
+    """
+
+    def __init__(self, out: Path | None) -> None:
+        self.out = out
+        self.path = None if out is None else out.with_name(out.name + ".lock")
+
+    def __enter__(self) -> _StoreLock:
+        if self.path is None:
+            return self
+        import socket
+
+        me = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.time()}
+        for _ in range(3):
+            try:
+                fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                holder = self._holder()
+                if holder is not None and holder.get("host") == me["host"] and not pid_alive(holder.get("pid")):
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(self.path)  # stale: its process is gone
+                    continue
+                if holder is None:  # being written this very instant
+                    time.sleep(0.05)
+                    continue
+                when = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(float(holder.get("started", 0))))
+                raise ParameterError(
+                    f'--out: "{self.out}" is being written by another sweep (pid {holder.get("pid")} on host '
+                    f'{holder.get("host")}, since {when}); wait for it to finish, or remove "{self.path}" if '
+                    "that process is gone"
+                ) from None
+            with os.fdopen(fd, "w") as fh:
+                json.dump(me, fh)
+            return self
+        raise ParameterError(f'--out: cannot take the lock "{self.path}"')
+
+    def _holder(self) -> dict[str, Any] | None:
+        try:
+            return json.loads(Path(self.path).read_text())  # type: ignore[arg-type]
+        except (OSError, ValueError):
+            return None
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.path is not None:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(self.path)
