@@ -174,3 +174,29 @@ def test_ten_million_case_sweep_starts_at_once_and_stops_on_ctrl_c(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err[-2000:]
     assert "Traceback" not in err
+
+
+def test_signal_swallowed_by_a_finaliser_is_delivered_again(tmp_path):
+    # a signal that arrives while Python runs a finaliser (matplotlib runs weakref
+    # callbacks at every figure) has its exception swallowed ("Exception ignored");
+    # the command must still stop with 143, without a traceback
+    code = (
+        "import os, signal, sys, time, click\n"
+        "from impactbeam.cli._group import _Commands\n"
+        "@click.group(cls=_Commands)\n"
+        "def group(): pass\n"
+        "@group.command()\n"
+        "def run():\n"
+        "    class Finalised:\n"
+        "        def __del__(self): os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    Finalised()\n"
+        "    time.sleep(10)\n"
+        "    print('not interrupted')\n"
+        "group()\n"
+    )
+    t0 = time.monotonic()
+    out = subprocess.run([sys.executable, "-c", code, "run"], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 143, out.stderr
+    assert "not interrupted" not in out.stdout
+    assert "Traceback" not in out.stderr and "Exception ignored" not in out.stderr
+    assert time.monotonic() - t0 < 8.0

@@ -156,28 +156,73 @@ class Interrupted(KeyboardInterrupt):
         self.signum = signum
 
 
+_received: list[int] = []  # the signal received, for the exit status and a re-delivery
+
+
 def _raise_interrupted(signum: int, frame: Any) -> None:
-    raise Interrupted(signum)
+    _received[:] = [int(signum)]
+    raise Interrupted(int(signum))
+
+
+def _redeliver(signum: int, frame: Any) -> None:
+    if _received:
+        raise Interrupted(_received[0])
+
+
+def _unraisable(previous: Callable[[Any], Any]) -> Callable[[Any], None]:
+    """An unraisable-exception hook that re-delivers a swallowed interruption.
+
+    An exception raised by a signal handler is swallowed ("Exception ignored
+    in ...") when the signal arrives while Python runs a finaliser or a weakref
+    callback (matplotlib's transform tree runs them at every figure). The hook
+    drops that report and raises the interruption again 10 ms later, in
+    ordinary code, through a one-shot timer.
+    """
+
+    def hook(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt) and _received:
+            signal.setitimer(signal.ITIMER_REAL, 0.01)
+            return
+        previous(unraisable)
+
+    return hook
+
+
+def _install_handlers() -> dict[int, Any]:
+    """Our handlers for SIGTERM, SIGINT and the re-delivery timer; returns the previous ones."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    handlers = {signal.SIGTERM: _raise_interrupted, signal.SIGINT: _raise_interrupted, signal.SIGALRM: _redeliver}
+    return {sig: signal.signal(sig, handler) for sig, handler in handlers.items()}
+
+
+def _handled() -> None:
+    """The interruption reached the command group: no re-delivery."""
+    if threading.current_thread() is threading.main_thread():
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+    _received.clear()
 
 
 class _Commands(click.Group):
     """The command group: Ctrl-C exits 130 and SIGTERM 143, with one line, never a traceback."""
 
     def main(self, *args: Any, **kwargs: Any) -> Any:
-        previous = None
-        if threading.current_thread() is threading.main_thread():
-            previous = signal.signal(signal.SIGTERM, _raise_interrupted)
+        previous = _install_handlers()
+        hook, sys.unraisablehook = sys.unraisablehook, _unraisable(sys.unraisablehook)
         try:
             return super().main(*args, **kwargs)
         finally:
-            if previous is not None:
-                signal.signal(signal.SIGTERM, previous)
+            _handled()
+            sys.unraisablehook = hook
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
         except KeyboardInterrupt as exc:
-            signum = int(getattr(exc, "signum", signal.SIGINT))
+            signum = int(getattr(exc, "signum", _received[0] if _received else signal.SIGINT))
+            _handled()
             click.echo(f"interrupted ({signal.Signals(signum).name}): stopped; finished files are kept, "
                        "nothing half-written", err=True)
             sys.exit(128 + signum)
