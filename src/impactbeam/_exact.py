@@ -37,7 +37,7 @@ References
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -359,19 +359,26 @@ def count(lay: Layout, beta: float) -> int:
 # --------------------------------------------------------------------------- rigid-body modes
 
 
-def rigid_mass_matrix(lay: Layout) -> np.ndarray:
-    """Mass matrix of the rigid shapes ``(1, x)``: beam, point masses and rotary inertias."""
+def rigid_mass_matrix(lay: Layout, rotary: float = 0.0) -> np.ndarray:
+    """Mass matrix of the rigid shapes ``(1, x)``: beam, point masses and rotary inertias.
+
+    ``rotary`` is the beam's own rotary inertia ``int rho I dx`` [kg m^2]
+    (a Timoshenko beam's cross-sections turn with a rigid rotation).
+    """
     a, b = lay.nodes[:-1], lay.nodes[1:]
     rA = lay.rhoA_seg
     m01 = np.sum(rA * (b**2 - a**2)) / 2.0
     M = np.array([[np.sum(rA * (b - a)), m01], [m01, np.sum(rA * (b**3 - a**3)) / 3.0]])
     x, m = lay.nodes, lay.m
-    M += np.array([[np.sum(m), np.sum(m * x)], [np.sum(m * x), np.sum(m * x**2) + np.sum(lay.J)]])
+    M += np.array([[np.sum(m), np.sum(m * x)], [np.sum(m * x), np.sum(m * x**2) + np.sum(lay.J) + rotary]])
     return M
 
 
-def rigid_modes(lay: Layout) -> np.ndarray:
-    """Mass-normalised rigid-body modes ``W = c0 + c1 x``: array (r, 2) of (c0, c1)."""
+def rigid_modes(lay: Layout, rotary: float = 0.0) -> np.ndarray:
+    """Mass-normalised rigid-body modes ``W = c0 + c1 x``: array (r, 2) of (c0, c1).
+
+    ``rotary``: the beam's own rotary inertia, see :func:`rigid_mass_matrix`.
+    """
     rows = [[1.0, x] for x, k in zip(lay.nodes, lay.k) if k > 0.0]
     if np.any(lay.kt > 0.0):
         rows.append([0.0, 1.0])
@@ -384,7 +391,7 @@ def rigid_modes(lay: Layout) -> np.ndarray:
         null = (vt[rank:] * scale).T  # (2, r)
     else:
         null = np.eye(2)
-    M = rigid_mass_matrix(lay)
+    M = rigid_mass_matrix(lay, rotary)
     if null.shape[1] == 2:  # free-free: translation first, then rotation about mid-span
         null = np.array([[1.0, -L / 2.0], [0.0, 1.0]])
     out: list[np.ndarray] = []
@@ -405,16 +412,28 @@ def rigid_modes(lay: Layout) -> np.ndarray:
 
 def bracket_roots(lay: Layout, n_needed: int, j0: int) -> list[tuple[float, float, int]]:
     """Brackets ``(lo, hi, index)`` of the first ``n_needed`` elastic wavenumbers."""
+    return bracket_wavenumbers(lambda beta: count(lay, beta), lay, n_needed, j0)
+
+
+def bracket_wavenumbers(
+    count_fn: Callable[[float], int], lay: Layout, n_needed: int, j0: int
+) -> list[tuple[float, float, int]]:
+    """Brackets ``(lo, hi, index)`` of the first ``n_needed`` roots, each alone, by bisecting a count.
+
+    ``count_fn(beta)`` is the number of natural frequencies below the
+    reference wavenumber ``beta`` (Euler-Bernoulli or Timoshenko); ``j0``
+    roots (the rigid-body modes) lie at zero.
+    """
     if n_needed <= 0:
         return []
     target = j0 + n_needed
     L = lay.nodes[-1]
     hi = (n_needed + 1.5) * math.pi / L * 1.0137 / float(np.max(lay.r))  # off any root of a classical beam
-    jhi = count(lay, hi)
+    jhi = count_fn(hi)
     guard = 0
     while jhi < target:
         hi *= 1.6
-        jhi = count(lay, hi)
+        jhi = count_fn(hi)
         guard += 1
         if guard > 200:
             raise ModeSolveError("could not bound the requested natural frequencies")
@@ -432,7 +451,7 @@ def bracket_roots(lay: Layout, n_needed: int, j0: int) -> list[tuple[float, floa
             out.extend((lo, up, j) for j in range(jlo, min(jup, target)))
             continue
         mid = 0.5 * (lo + up)
-        jm = count(lay, mid)
+        jm = count_fn(mid)
         stack.append((mid, up, jm, jup))
         stack.append((lo, mid, jlo, jm))
     out.sort(key=lambda b: b[2])

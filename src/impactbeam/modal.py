@@ -73,6 +73,7 @@ from .model.beam import Beam
 from .exceptions import ParameterError
 
 if TYPE_CHECKING:
+    from ._timoshenko import TimoshenkoShapes
     from .scenario import Scenario
 
 __all__ = ["ModeSet", "ScenarioModes", "mode_set", "scenario_modes", "modes", "count_below"]
@@ -114,6 +115,7 @@ class ModeSet:
     _coef: np.ndarray = field(repr=False)  # (n, s, 4) elastic coefficients
     _rigid: np.ndarray = field(repr=False)  # (n_rigid, 2)
     _kry: np.ndarray = field(repr=False)  # (n, s) True where a segment uses the Krylov basis
+    _timo: TimoshenkoShapes | None = field(default=None, repr=False)  # elastic shapes of a Timoshenko beam
 
     def _repr_html_(self) -> str:
         """Compact summary table for Jupyter: the state's springs and first frequencies."""
@@ -165,7 +167,9 @@ class ModeSet:
                 out[:r] = c[:, :1] + c[:, 1:] * x[None, :]
             elif derivative == 1:
                 out[:r] = c[:, 1:]
-        if self.count > r:
+        if self.count > r and self._timo is not None:
+            out[r:] = self._timo.derivative(x, derivative)
+        elif self.count > r:
             seg = np.clip(np.searchsorted(lay.nodes, x, side="right") - 1, 0, lay.n_segments - 1)
             u = x - lay.nodes[seg]
             ell = lay.lengths[seg]
@@ -194,7 +198,46 @@ class ModeSet:
             Positions on the beam.
         """
         x = np.atleast_1d(np.asarray(x, dtype=float))
+        if self._timo is not None:  # M = EI Psi'
+            out = np.zeros((self.count, x.size))
+            out[self.n_rigid :] = self._timo.state(x)[2]
+            return out
         return self.beam.bending_stiffness_at(x)[None, :] * self.shapes(x, 2)
+
+    def rotations(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """Cross-section rotation per unit modal coordinate [kg^-0.5], shape (n, p).
+
+        ``W'`` for an Euler-Bernoulli beam; the independent field ``Psi`` of a
+        Timoshenko beam (``W' - Psi`` is the shear strain).
+
+        Parameters
+        ----------
+        x : float or array_like, [m]
+            Positions on the beam.
+        """
+        if self._timo is None:
+            return self.shapes(x, 1)
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        out = np.zeros((self.count, x.size))
+        out[: self.n_rigid] = self._rigid[:, 1:]
+        out[self.n_rigid :] = self._timo.state(x)[1]
+        return out
+
+    def _kinetic(self, other: ModeSet, x: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``int rho A W W~ + rho I Psi Psi~`` (the last for a Timoshenko beam) plus the point masses."""
+        P = (self.shapes(x) * (w * self.beam.mass_per_length_at(x))) @ other.shapes(x).T
+        if self._timo is not None:
+            P = P + (self.rotations(x) * (w * self.beam.rotary_inertia_at(x))) @ other.rotations(x).T
+        lay = self._layout
+        at = lay.m > 0.0
+        if np.any(at):
+            xm = lay.nodes[at]
+            P = P + (self.shapes(xm) * lay.m[at]) @ other.shapes(xm).T
+        at = lay.J > 0.0
+        if np.any(at):
+            xj = lay.nodes[at]
+            P = P + (self.rotations(xj) * lay.J[at]) @ other.rotations(xj).T
+        return P
 
     def __call__(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
         """Same as :meth:`shapes` with ``derivative=0``."""
@@ -203,6 +246,10 @@ class ModeSet:
     @functools.cached_property
     def _beta_max(self) -> float:
         """Largest segment wavenumber of the set [1/m]."""
+        if self._timo is not None and self._timo.omega.size:
+            from ._timoshenko import wavenumbers
+
+            return float(wavenumbers(self._timo.mesh.seg, float(self._timo.omega.max()))[0].max())
         return float(self.beta.max(initial=1.0 / self.beam.length) * np.max(self._layout.r))
 
     @functools.cached_property
@@ -250,8 +297,9 @@ class ModeSet:
         """Projection matrix ``P[n, p] = <W_n^self, W_p^other>`` (paper eq. 12).
 
         The inner product is the kinetic-energy one, ``int rho A(x) W W' dx``
-        plus ``m_j W(x_j) W'(x_j) + J_j W_x(x_j) W'_x(x_j)`` at the point masses
-        (those of this set's layout). ``eta_self = P @ eta_other`` carries modal
+        (plus ``int rho I Psi Psi' dx`` for a Timoshenko beam) and
+        ``m_j W(x_j) W'(x_j) + J_j Psi(x_j) Psi'(x_j)`` at the point masses
+        (those of this set's layout; ``Psi = W_x`` for Euler-Bernoulli). ``eta_self = P @ eta_other`` carries modal
         coordinates of ``other`` into this set (displacement and velocity alike).
 
         Parameters
@@ -267,16 +315,7 @@ class ModeSet:
             return hit[1].copy()
         breaks = np.union1d(self.nodes, other.nodes)
         x, w = quadrature(breaks, max(self._beta_max, other._beta_max))
-        P = (self.shapes(x) * (w * self.beam.mass_per_length_at(x))) @ other.shapes(x).T
-        lay = self._layout
-        at = lay.m > 0.0
-        if np.any(at):
-            xm = lay.nodes[at]
-            P = P + (self.shapes(xm) * lay.m[at]) @ other.shapes(xm).T
-        at = lay.J > 0.0
-        if np.any(at):
-            xj = lay.nodes[at]
-            P = P + (self.shapes(xj, 1) * lay.J[at]) @ other.shapes(xj, 1).T
+        P = self._kinetic(other, x, w)
         P.setflags(write=False)
         cache[id(other)] = (other, P)
         return P.copy()
@@ -313,56 +352,67 @@ def _clusters(betas: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _build(lay: Layout, beam: Beam, springs: tuple[tuple[float, float], ...], count: int) -> ModeSet:
-    rigid = rigid_modes(lay)
+    rotary = float(np.sum(beam.rotary_inertia_at(0.5 * (lay.nodes[:-1] + lay.nodes[1:])) * lay.lengths))
+    rigid = rigid_modes(lay, rotary if beam.is_timoshenko else 0.0)
     r = min(rigid.shape[0], count)
-    brackets = bracket_roots(lay, count - r, rigid.shape[0])
-    betas = np.array([refine(lay, lo, hi, j) for lo, hi, j in brackets], dtype=float)
     s = lay.n_segments
     coef = np.zeros((count, s, 4))
     kry = np.zeros((count, s), dtype=bool)
-    groups = _clusters(betas)
-    for i, j in groups:
-        b_mid = float(np.mean(betas[i:j]))
-        mask = krylov_mask(lay, b_mid)
-        if j - i == 1:
-            coef[r + i] = null_vector(lay, betas[i], mask).reshape(s, 4)
-        else:  # (nearly) repeated root: the null space of the cluster
-            _, _, vt = np.linalg.svd(characteristic(lay, b_mid, mask))
-            for m in range(j - i):
-                coef[r + i + m] = vt[-(m + 1)].reshape(s, 4)
-        kry[r + i : r + j] = mask
-    beta_all = np.concatenate([np.zeros(r), betas])
     c2 = math.sqrt(lay.EI / lay.rhoA)
-    ms = ModeSet(beam, springs, beta_all**2 * c2, beta_all, r, lay, coef, rigid[:r], kry)
-    # normalise elastic shapes in the kinetic-energy inner product, largest displacement positive
-    if count > r:
-        x, w = ms._quad
-        wr = w * beam.mass_per_length_at(x)
-        xm, mm = lay.nodes[lay.m > 0.0], lay.m[lay.m > 0.0]
-        xj, jj = lay.nodes[lay.J > 0.0], lay.J[lay.J > 0.0]
+    timo = None
+    if beam.is_timoshenko:
+        from . import _timoshenko
 
-        def gram(lo: int, hi: int) -> np.ndarray:
-            W = ms.shapes(x)[lo:hi]
-            G = (W * wr) @ W.T
-            if xm.size:
-                Wm = ms.shapes(xm)[lo:hi]
-                G += (Wm * mm) @ Wm.T
-            if xj.size:
-                Wj = ms.shapes(xj, 1)[lo:hi]
-                G += (Wj * jj) @ Wj.T
-            return G
-
-        # mass-orthonormalise within clusters of repeated roots (Gram-Schmidt)
+        timo = _timoshenko.solve(_timoshenko.segments(beam, lay), count - r, rigid.shape[0])
+        betas = np.sqrt(timo.omega / c2)  # the Euler-Bernoulli-equivalent wavenumber, omega = beta^2 c
+        groups = _clusters(betas)
+    else:
+        brackets = bracket_roots(lay, count - r, rigid.shape[0])
+        betas = np.array([refine(lay, lo, hi, j) for lo, hi, j in brackets], dtype=float)
+        groups = _clusters(betas)
         for i, j in groups:
-            if j - i > 1:
-                T = np.linalg.inv(np.linalg.cholesky(gram(r + i, r + j)))
-                coef[r + i : r + j] = np.einsum("ab,bsk->ask", T, coef[r + i : r + j])
-        norms = np.sqrt(np.diag(gram(r, count)))
-        W = ms.shapes(x)[r:]
-        idx = np.argmax(np.abs(W), axis=1)
-        sign = np.sign(W[np.arange(W.shape[0]), idx])
-        coef[r:] *= (sign / norms)[:, None, None]
+            b_mid = float(np.mean(betas[i:j]))
+            mask = krylov_mask(lay, b_mid)
+            if j - i == 1:
+                coef[r + i] = null_vector(lay, betas[i], mask).reshape(s, 4)
+            else:  # (nearly) repeated root: the null space of the cluster
+                _, _, vt = np.linalg.svd(characteristic(lay, b_mid, mask))
+                for m in range(j - i):
+                    coef[r + i + m] = vt[-(m + 1)].reshape(s, 4)
+            kry[r + i : r + j] = mask
+    beta_all = np.concatenate([np.zeros(r), betas])
+    omega = np.concatenate([np.zeros(r), timo.omega]) if timo is not None else beta_all**2 * c2
+    ms = ModeSet(beam, springs, omega, beta_all, r, lay, coef, rigid[:r], kry, timo)
+    if count > r:
+        _normalise(ms, groups)
     return ms
+
+
+def _normalise(ms: ModeSet, groups: list[tuple[int, int]]) -> None:
+    """Orthonormalise the elastic shapes in the kinetic-energy inner product, largest displacement positive.
+
+    Within a cluster of repeated roots by Gram-Schmidt (Cholesky); the
+    coefficients are scaled in place (the set is being built).
+    """
+    r, n = ms.n_rigid, ms.count
+    x, w = ms._quad
+    gram = ms._kinetic(ms, x, w)
+    scale = np.ones(n)
+    mix = np.eye(n)
+    for i, j in groups:
+        if j - i > 1:
+            sl = slice(r + i, r + j)
+            mix[sl, sl] = np.linalg.inv(np.linalg.cholesky(gram[sl, sl]))
+    gram = mix @ gram @ mix.T
+    scale[r:] = 1.0 / np.sqrt(np.diag(gram)[r:])
+    W = (mix @ ms.shapes(x))[r:]
+    idx = np.argmax(np.abs(W), axis=1)
+    scale[r:] *= np.sign(W[np.arange(W.shape[0]), idx])
+    T = (scale[:, None] * mix)[r:, r:]
+    if ms._timo is not None:
+        ms._timo.coef[...] = np.einsum("ab,bekc->aekc", T, ms._timo.coef)
+    else:
+        ms._coef[r:] = np.einsum("ab,bsk->ask", T, ms._coef[r:])
 
 
 @functools.lru_cache(maxsize=512)

@@ -69,13 +69,16 @@ def _structure(beam: Any) -> dict[str, Any]:
         "masses": [{"position": m.position, "mass": m.mass, "rotary_inertia": m.rotary_inertia} for m in beam.masses],
         "springs": [{"position": s.position, "translational": rigid(s.translational), "rotational": rigid(s.rotational)}
                     for s in beam.springs],
+        "theory": beam.theory,
+        **({"poisson_ratio": beam.poisson_ratio, "shear_coefficient": beam.kappa} if beam.is_timoshenko else {}),
     }
 
 
 def _modes_table(sc: Any, ms: Any, free: list[float], contact: list[float] | None) -> str:
     n_contactors = len(sc.contactors)
-    title = f"Natural frequencies of {sc.name!r}: {sc.beam.left.describe()}-{sc.beam.right.describe()} beam"
     b = sc.beam
+    kind = f"Timoshenko beam (nu = {b.poisson_ratio:g}, kappa = {b.kappa:.4g})" if b.is_timoshenko else "beam"
+    title = f"Natural frequencies of {sc.name!r}: {b.left.describe()}-{b.right.describe()} {kind}"
     extras = [f"{len(b.sections)} sections" if b.sections else "",
               f"{len(b.masses)} point mass{'es' if len(b.masses) > 1 else ''}" if b.masses else "",
               f"{len(b.springs)} interior spring{'s' if len(b.springs) > 1 else ''}" if b.springs else ""]

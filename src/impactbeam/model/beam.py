@@ -183,6 +183,16 @@ class Beam:
     masses : tuple of PointMass
     springs : tuple of InteriorSpring
         Permanent interior (or end) springs, added to the end supports at an end.
+    theory : {"euler-bernoulli", "timoshenko"}
+        Euler-Bernoulli (the paper's eq. 1, default) or Timoshenko (shear
+        deformation and rotary inertia, :mod:`impactbeam._timoshenko`).
+    poisson_ratio : float or None
+        Poisson's ratio, in (-1, 0.5); a Timoshenko beam needs it (the shear
+        modulus of each section is ``G = E / (2 (1 + nu))``).
+    shear_coefficient : float or None
+        Timoshenko shear coefficient ``kappa``; default Cowper's value for a
+        rectangle, ``10 (1 + nu) / (12 + 11 nu)`` (a section given as area and
+        second moment needs it).
     """
 
     length: float
@@ -197,6 +207,9 @@ class Beam:
     sections: tuple[Section, ...] = ()
     masses: tuple[PointMass, ...] = ()
     springs: tuple[InteriorSpring, ...] = ()
+    theory: Literal["euler-bernoulli", "timoshenko"] = "euler-bernoulli"
+    poisson_ratio: float | None = None
+    shear_coefficient: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("length", "youngs_modulus", "density", "area", "second_moment"):
@@ -216,6 +229,7 @@ class Beam:
                 raise ParameterError(
                     f"beam.sections: the section lengths sum to {total:.12g} m, not beam.length = {self.length:.12g} m"
                 )
+        self._check_theory()
         tol = 1e-12 * self.length
         for name in ("masses", "springs"):
             for i, item in enumerate(getattr(self, name)):
@@ -223,6 +237,44 @@ class Beam:
                     raise ParameterError(
                         f"{name}[{i}].position: {item.position:g} m is off the beam (length {self.length:g} m)"
                     )
+
+    def _check_theory(self) -> None:
+        choice("beam.theory", self.theory, ("euler-bernoulli", "timoshenko"))
+        nu, kappa = self.poisson_ratio, self.shear_coefficient
+        if nu is not None:
+            nu = float(nu)
+            if not -1.0 < nu < 0.5:
+                raise ParameterError(f"beam.poisson_ratio: must lie in (-1, 0.5), got {nu!r}")
+            object.__setattr__(self, "poisson_ratio", nu)
+        if kappa is not None:
+            object.__setattr__(self, "shear_coefficient", positive_finite("beam.shear_coefficient", kappa))
+        if self.theory == "euler-bernoulli":
+            return
+        if nu is None:
+            raise ParameterError("beam.poisson_ratio: a Timoshenko beam needs it (or beam.shear_modulus)")
+        if kappa is None and any(p.height is None for p in self.pieces()):
+            raise ParameterError(
+                "beam.shear_coefficient: required for a section given as area and second_moment "
+                "(Cowper's default needs a rectangle)"
+            )
+
+    @property
+    def is_timoshenko(self) -> bool:
+        """True for a Timoshenko beam (``theory = "timoshenko"``)."""
+        return self.theory == "timoshenko"
+
+    @property
+    def kappa(self) -> float:
+        """Shear coefficient: the given one, else Cowper's for a rectangle ``10 (1 + nu) / (12 + 11 nu)``."""
+        if self.shear_coefficient is not None:
+            return float(self.shear_coefficient)
+        nu = 0.3 if self.poisson_ratio is None else self.poisson_ratio
+        return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
+
+    def shear_stiffness(self, piece: Section) -> float:
+        """``kappa G A`` of one piece [N], ``G = E / (2 (1 + nu))``."""
+        nu = 0.3 if self.poisson_ratio is None else self.poisson_ratio
+        return self.kappa * piece.youngs_modulus / (2.0 * (1.0 + nu)) * piece.area
 
     @classmethod
     def rectangular(
@@ -254,8 +306,8 @@ class Beam:
 
     @property
     def is_uniform(self) -> bool:
-        """True for the paper's beam: one section, no masses, no interior springs."""
-        return not (self.sections or self.masses or self.springs)
+        """True for the paper's beam: Euler-Bernoulli, one section, no masses, no interior springs."""
+        return not (self.sections or self.masses or self.springs or self.is_timoshenko)
 
     def pieces(self) -> tuple[Section, ...]:
         """The uniform pieces from x = 0 (one piece with the ``[beam]`` values if not stepped)."""
@@ -301,6 +353,16 @@ class Beam:
             Positions on the beam.
         """
         return self._piece_values(x, "density") * self._piece_values(x, "area")
+
+    def rotary_inertia_at(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """rho I(x) [kg m], the rotary inertia per length (used by a Timoshenko beam).
+
+        Parameters
+        ----------
+        x : float or array_like, [m]
+            Positions on the beam.
+        """
+        return self._piece_values(x, "density") * self._piece_values(x, "second_moment")
 
     def fibre_distance_at(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
         """Outer-fibre distance c(x) = height / 2 [m] (NaN where the section was given as area and I).

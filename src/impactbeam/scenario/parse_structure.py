@@ -49,10 +49,11 @@ def _parse_support(value: Any, key: str) -> Support:
 def _parse_beam(raw: Mapping[str, Any]) -> Beam:
     """The ``[beam]`` table with its supports, ``[[beam.sections]]``, ``[[masses]]`` and ``[[springs]]``."""
     beam = _parse_uniform_beam(raw)
+    theory = _parse_theory(raw["beam"], beam.youngs_modulus)
     sections = _parse_sections(raw["beam"], beam)
     masses, springs = _parse_attachments(raw, beam.length)
     with _relabel("beam", (("beam.sections", "beam.sections"),)):
-        return dataclasses.replace(beam, sections=sections, masses=masses, springs=springs)
+        return dataclasses.replace(beam, sections=sections, masses=masses, springs=springs, **theory)
 
 
 def _parse_sections(b: Mapping[str, Any], beam: Beam) -> tuple[Section, ...]:
@@ -122,26 +123,40 @@ def _parse_attachments(
     return tuple(masses), tuple(springs)
 
 
-def _check_theory(b: Mapping[str, Any]) -> None:
-    """``beam.theory``: Euler-Bernoulli (the paper's). Timoshenko keys are refused by name, never ignored."""
+def _parse_theory(b: Mapping[str, Any], modulus: float) -> dict[str, Any]:
+    """``beam.theory`` and the Timoshenko keys (refused by name on an Euler-Bernoulli beam, never ignored)."""
     theory = _choice("beam.theory", b.get("theory", "euler-bernoulli"), ("euler-bernoulli", "timoshenko"))
-    if theory == "timoshenko":
-        raise ScenarioError(
-            'beam.theory: "timoshenko" is not available in this version; the beam is Euler-Bernoulli '
-            '(remove beam.theory or set it to "euler-bernoulli")',
-            key="beam.theory",
-        )
-    for name in ("poisson_ratio", "shear_modulus", "shear_coefficient"):
-        if name in b:
-            raise ScenarioError(f"beam.{name}: only used by a Timoshenko beam (beam.theory); remove it",
-                                key=f"beam.{name}")
+    if theory == "euler-bernoulli":
+        for name in ("poisson_ratio", "shear_modulus", "shear_coefficient"):
+            if name in b:
+                raise ScenarioError(f'beam.{name}: only used by a Timoshenko beam (beam.theory = "timoshenko"); '
+                                    "remove it", key=f"beam.{name}")
+        return {}
+    if "poisson_ratio" in b and "shear_modulus" in b:
+        raise ScenarioError("beam.shear_modulus: give poisson_ratio or shear_modulus, not both", key="beam.shear_modulus")
+    if "shear_modulus" in b:
+        shear = _positive(b, "beam", "shear_modulus", "modulus")
+        nu = modulus / (2.0 * shear) - 1.0
+        if not -1.0 < nu < 0.5:
+            raise ScenarioError(f"beam.shear_modulus: G = {shear:g} Pa gives a Poisson ratio E / 2G - 1 = {nu:.4g}, "
+                                "outside (-1, 0.5)", key="beam.shear_modulus")
+    elif "poisson_ratio" in b:
+        nu = to_si(b["poisson_ratio"], "dimensionless", "beam.poisson_ratio")
+        if not -1.0 < nu < 0.5:
+            raise ScenarioError(f"beam.poisson_ratio: must lie in (-1, 0.5), got {nu!r}", key="beam.poisson_ratio")
+    else:
+        raise ScenarioError('beam.poisson_ratio: required for beam.theory = "timoshenko" (or beam.shear_modulus)',
+                            key="beam.poisson_ratio")
+    out: dict[str, Any] = {"theory": theory, "poisson_ratio": nu}
+    if "shear_coefficient" in b:
+        out["shear_coefficient"] = _positive(b, "beam", "shear_coefficient", "dimensionless")
+    return out
 
 
 def _parse_uniform_beam(raw: Mapping[str, Any]) -> Beam:
     if "beam" not in raw:
         raise ScenarioError("beam: the [beam] table is required", key="beam")
     b = raw["beam"]
-    _check_theory(b)
     for name in ("length", "youngs_modulus", "density"):
         _required(b, "beam", name)
     length = _positive(b, "beam", "length", "length")

@@ -70,7 +70,7 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
     springs; a beam with sections, point masses or interior springs uses the
     paper's per-state modes (a warning says so).
     """
-    if options.basis == "enriched" and _uniform(beam):
+    if options.basis == "enriched" and beam.is_uniform:
         from .ritz import RitzStateSpace
 
         return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points)  # type: ignore[return-value]
@@ -78,16 +78,11 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
         from .._warnings import emit_user_level_warning
 
         emit_user_level_warning(
-            'solver.basis: the enriched basis does not support [[beam.sections]], [[masses]] or [[springs]] '
-            'yet; using the paper\'s per-state modes (solver.basis = "paper"), which need more modes for stiff '
+            'solver.basis: the enriched basis does not support [[beam.sections]], [[masses]], [[springs]] or '
+            'a Timoshenko beam yet; using the paper\'s per-state modes (solver.basis = "paper"), which need more modes for stiff '
             "contactors"
         )
     return StateSpace(beam, contactors, damping, excitation, options.modes, points)
-
-
-def _uniform(beam: Beam) -> bool:
-    """The enriched basis's static shapes are those of a uniform beam with end springs only."""
-    return not (beam.sections or beam.masses or beam.springs)
 
 
 def space_initial_coordinates(space, beam: Beam, initial: InitialCondition, n_modes: int):

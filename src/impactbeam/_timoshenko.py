@@ -1,0 +1,375 @@
+r"""Exact natural frequencies and mode shapes of a Timoshenko beam.
+
+The engine of :mod:`impactbeam.modal` for ``[beam] theory = "timoshenko"``.
+On a uniform segment with bending stiffness ``EI``, shear stiffness
+``kappa G A``, mass ``rho A`` and rotary inertia ``rho I`` per length, a
+harmonic motion ``w = W(x) cos(omega t)``, ``psi = Psi(x) cos(omega t)``
+(``psi`` the rotation of the cross-section) obeys
+
+.. math:: \kappa G A (W'' - \Psi') + \rho A \omega^2 W = 0, \qquad
+          E I \Psi'' + \kappa G A (W' - \Psi) + \rho I \omega^2 \Psi = 0,
+
+the Timoshenko form of the paper's eq. (1) (its conclusions ask for shear).
+With the bending moment ``M = EI Psi'`` and the shear force
+``V = kappa G A (W' - Psi)`` the state ``y = (W, Psi, M, V)`` satisfies
+``y' = A(omega) y``,
+
+.. math:: A = \begin{pmatrix} 0 & 1 & 0 & 1/\kappa GA \\ 0 & 0 & 1/EI & 0 \\
+          0 & -\rho I \omega^2 & 0 & -1 \\ -\rho A \omega^2 & 0 & 0 & 0 \end{pmatrix},
+
+whose eigenvalues are ``+-mu_1`` and ``+-i k_2``: ``mu_1`` is real below the
+cut-off ``omega_c = sqrt(kappa G A / rho I)`` of the second spectrum and
+imaginary above it. Rather than switch between the two closed forms (which
+degenerate at the cut-off), each segment is cut into ``n`` equal elements
+short enough that ``k_2 h <= 1``, and the transfer matrix ``exp(A h)`` of an
+element is summed as its Taylor series (26 terms: the truncation is below
+``1e-26``), exact in both regimes and through the cut-off.
+
+Nodes carry the end supports and attachments as for Euler-Bernoulli, acting
+on the cross-section rotation: ``[M]^+_- = (K_t - J omega^2) Psi`` and
+``-[V]^+_- = (k - m omega^2) W`` (an end spring alone gives the paper's end
+conditions with ``W'`` replaced by ``Psi``).
+
+Roots are counted with the Wittrick-Williams algorithm on the exact dynamic
+stiffness of the elements. An element is short enough that its
+clamped-clamped frequencies all lie above ``omega``: with zero end values,
+Friedrichs' inequality ``int f^2 <= (h / pi)^2 int f'^2`` bounds the kinetic
+energy by ``C (U_bending + U_shear)`` with
+``C = max(2 rho A h^2 / (pi^2 kappa G A), (2 rho A h^4 / pi^2 + rho I h^2) / (pi^2 EI))``,
+so ``omega^2 C < 1`` guarantees ``J_0 = 0``. The count is then the number of
+negative eigenvalues of the assembled (banded) dynamic stiffness matrix, and a
+root is the zero of its eigenvalue of the bracket's index, which decreases
+monotonically with ``omega``.
+
+References
+----------
+.. [1] W. Xu, E. K. Ervin, Shock and Vibration 20 (2013), eq. (1) and conclusions.
+.. [2] S. P. Timoshenko, Phil. Mag. 41 (1921) 744-746.
+.. [3] W. P. Howson, F. W. Williams, "Natural frequencies of frames with axially
+   loaded Timoshenko members", J. Sound Vib. 26 (1973) 503-515.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._exact import Layout, bracket_wavenumbers
+from ._roots import brentq
+from .exceptions import ModeSolveError
+from .model.beam import Beam
+
+__all__ = ["Segments", "TimoshenkoShapes", "segments", "solve"]
+
+_TERMS = 26  # Taylor terms of exp(A h) with spectral radius <= 1: truncation < 1 / 27!
+_FACT = np.array([math.factorial(n) for n in range(_TERMS + 1)], dtype=float)
+_J0_MARGIN = 0.9  # omega^2 C <= 0.9 < 1: clamped element frequencies stay above omega
+
+
+@dataclass(frozen=True)
+class Segments:
+    """Timoshenko properties of the uniform segments of a :class:`~impactbeam._exact.Layout`."""
+
+    lay: Layout
+    EI: np.ndarray  # [N m^2]
+    GA: np.ndarray  # kappa G A [N]
+    rhoA: np.ndarray  # [kg/m]
+    rhoI: np.ndarray  # [kg m]
+
+
+def segments(beam: Beam, lay: Layout) -> Segments:
+    """The properties of each segment of ``lay`` from the pieces of ``beam``."""
+    pieces = beam.pieces()
+    edges = np.concatenate([[0.0], np.cumsum([p.length for p in pieces])])
+    mid = 0.5 * (lay.nodes[:-1] + lay.nodes[1:])
+    idx = np.clip(np.searchsorted(edges, mid, side="right") - 1, 0, len(pieces) - 1)
+    sel = [pieces[i] for i in idx]
+    return Segments(
+        lay,
+        np.array([p.bending_stiffness for p in sel]),
+        np.array([beam.shear_stiffness(p) for p in sel]),
+        np.array([p.mass_per_length for p in sel]),
+        np.array([p.density * p.second_moment for p in sel]),
+    )
+
+
+# --------------------------------------------------------------------------- elements
+
+
+def wavenumbers(seg: Segments, omega: float) -> tuple[np.ndarray, np.ndarray]:
+    """``k_2`` (propagating) and ``mu_1^2`` (> 0 below the cut-off, < 0 above) per segment."""
+    w2 = omega * omega
+    a = seg.rhoA * w2 / seg.GA
+    c = seg.rhoI * w2 / seg.EI
+    b4 = seg.rhoA * w2 / seg.EI
+    disc = np.sqrt((a - c) ** 2 + 4.0 * b4)
+    k2 = np.sqrt(0.5 * (a + c + disc))
+    mu2 = 2.0 * (b4 - a * c) / np.maximum(disc + a + c, np.finfo(float).tiny)  # no cancellation
+    return k2, mu2
+
+
+def subdivision(seg: Segments, omega: float) -> np.ndarray:
+    """Elements per segment valid for every frequency up to ``omega``: ``k_2 h <= 1`` and ``J_0 = 0``."""
+    lens = seg.lay.lengths
+    if omega <= 0.0:
+        return np.ones(lens.size, dtype=int)
+    k2, _ = wavenumbers(seg, omega)
+    w2 = omega * omega
+    pi2 = math.pi**2
+    h_shear = np.sqrt(_J0_MARGIN * pi2 * seg.GA / (2.0 * seg.rhoA * w2))
+    qa, qb = 2.0 * seg.rhoA / (pi2 * pi2 * seg.EI), seg.rhoI / (pi2 * seg.EI)  # qa X^2 + qb X <= 0.9 / w2
+    X = 2.0 * (_J0_MARGIN / w2) / (qb + np.sqrt(qb * qb + 4.0 * qa * _J0_MARGIN / w2))
+    h = np.minimum(np.minimum(1.0 / k2, h_shear), np.sqrt(X))
+    return np.maximum(1, np.ceil(lens / h * (1.0 + 1e-12))).astype(int)
+
+
+def _series(seg: Segments, h: np.ndarray, omega: float) -> np.ndarray:
+    """``A_hat^n / n!`` for n = 0.._TERMS of each segment's element, scaled state: shape (s, N+1, 4, 4).
+
+    The scaled state of an element of length ``h`` is ``(W, Psi h, M h^2/EI, V h^3/EI)`` in
+    ``xi = u / h``, so the series has entries of order one.
+    """
+    w2 = omega * omega
+    s = seg.EI.size
+    A = np.zeros((s, 4, 4))
+    A[:, 0, 1] = 1.0
+    A[:, 0, 3] = seg.EI / (seg.GA * h * h)
+    A[:, 1, 2] = 1.0
+    A[:, 2, 1] = -seg.rhoI * w2 * h * h / seg.EI
+    A[:, 2, 3] = -1.0
+    A[:, 3, 0] = -seg.rhoA * w2 * h**4 / seg.EI
+    out = np.empty((s, _TERMS + 1, 4, 4))
+    out[:, 0] = np.eye(4)
+    for n in range(1, _TERMS + 1):
+        out[:, n] = out[:, n - 1] @ A / n
+    return out
+
+
+def _scale(seg: Segments, h: np.ndarray, ell: float, EI0: float) -> np.ndarray:
+    """Diagonal taking an element's scaled state to the global one ``(W, Psi l, M l^2/EI0, V l^3/EI0)``."""
+    return np.stack([np.ones_like(h), ell / h, ell**2 * seg.EI / (h**2 * EI0), ell**3 * seg.EI / (h**3 * EI0)], 1)
+
+
+def _stiffness(T: np.ndarray) -> np.ndarray:
+    """Dynamic stiffness (s, 4, 4) of elements from their transfer matrices (global scaling).
+
+    Degrees of freedom ``(W0, Psi0 l, W1, Psi1 l)``; the conjugate end loads are
+    ``(-V0, -M0, V1, M1)`` scaled like the state.
+    """
+    Tdd, Tdg, Tgd, Tgg = T[:, :2, :2], T[:, :2, 2:], T[:, 2:, :2], T[:, 2:, 2:]
+    inv = np.linalg.inv(Tdg)
+    swap = np.array([[0.0, 1.0], [1.0, 0.0]])
+    K = np.empty(T.shape)
+    K[:, :2, :2] = swap @ (inv @ Tdd)
+    K[:, :2, 2:] = -swap @ inv
+    K[:, 2:, :2] = swap @ (Tgd - Tgg @ inv @ Tdd)
+    K[:, 2:, 2:] = swap @ (Tgg @ inv)
+    return 0.5 * (K + np.swapaxes(K, 1, 2))
+
+
+# --------------------------------------------------------------------------- the assembled problem
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Elements of every segment, fixed for all frequencies up to the one it was made for."""
+
+    seg: Segments
+    n: np.ndarray  # elements per segment
+    ell: float  # global length scale [m]
+
+    @property
+    def h(self) -> np.ndarray:
+        return self.seg.lay.lengths / self.n
+
+    @property
+    def first_node(self) -> np.ndarray:
+        """Global node index of each layout node."""
+        return np.concatenate([[0], np.cumsum(self.n)])
+
+    @property
+    def edges(self) -> np.ndarray:
+        """Element boundaries [m]."""
+        nodes = self.seg.lay.nodes
+        parts = [np.linspace(a, b, k + 1)[:-1] for a, b, k in zip(nodes[:-1], nodes[1:], self.n)]
+        return np.concatenate(parts + [nodes[-1:]])
+
+    def transfer(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """Element series (s, N+1, 4, 4) and global-scaled transfer matrices (s, 4, 4)."""
+        P = _series(self.seg, self.h, omega)
+        D = _scale(self.seg, self.h, self.ell, self.seg.lay.EI)
+        return P, D[:, :, None] * P.sum(axis=1) / D[:, None, :]
+
+    def band(self, omega: float) -> np.ndarray:
+        """Lower band storage (4, 2 n_nodes) of the dynamic stiffness with the node terms."""
+        lay = self.seg.lay
+        Ke = _stiffness(self.transfer(omega)[1])
+        ne = int(self.n.sum())
+        per = np.repeat(Ke, self.n, axis=0)  # (ne, 4, 4)
+        base = 2 * np.arange(ne)
+        ab = np.zeros((4, 2 * ne + 2))
+        for r in range(4):
+            for c in range(r + 1):
+                np.add.at(ab[r - c], base + c, per[:, r, c])
+        EI0, ell, w2 = lay.EI, self.ell, omega * omega
+        dof = 2 * self.first_node
+        scale = np.abs(ab[0]).max(initial=1.0)
+        for node, d in enumerate(dof):
+            for j, (spring, inertia, factor) in enumerate(
+                ((lay.k[node], lay.m[node], ell**3 / EI0), (lay.kt[node], lay.J[node], ell / EI0))
+            ):
+                if math.isinf(spring):  # a rigid support: the row and column become a positive constant
+                    g = d + j
+                    ab[0, g] = scale
+                    for off in (1, 2, 3):
+                        ab[off, g] = 0.0
+                        if g - off >= 0:
+                            ab[off, g - off] = 0.0
+                else:
+                    ab[0, d + j] += (spring - inertia * w2) * factor
+        return ab
+
+    def count(self, omega: float) -> int:
+        """Natural frequencies below ``omega`` (valid for omega up to the mesh's frequency)."""
+        from scipy.linalg import eigvals_banded
+
+        return int(eigvals_banded(self.band(omega), lower=True, select="v", select_range=(-np.inf, 0.0)).size)
+
+    def eigen(self, omega: float, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues ``lo..hi`` (ascending, inclusive) of the dynamic stiffness and their vectors."""
+        from scipy.linalg import eig_banded
+
+        return eig_banded(self.band(omega), lower=True, select="i", select_range=(lo, hi))
+
+
+def _mesh(seg: Segments, omega: float) -> Mesh:
+    n = subdivision(seg, omega)
+    return Mesh(seg, n, float(seg.lay.nodes[-1] / n.sum()))
+
+
+def count_below(seg: Segments, omega: float) -> int:
+    """Wittrick-Williams count of natural frequencies strictly below ``omega`` [rad/s]."""
+    return _mesh(seg, omega).count(omega)
+
+
+# --------------------------------------------------------------------------- shapes
+
+
+@dataclass(frozen=True, eq=False)
+class TimoshenkoShapes:
+    """Elastic mode shapes as a Taylor series per element (scaled state, see :func:`_series`)."""
+
+    mesh: Mesh
+    omega: np.ndarray  # (n,)
+    coef: np.ndarray  # (n, elements, N+1, 4)
+
+    def state(self, x: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(W, Psi, M, V)`` per unit modal coordinate at ``x``: four arrays (n, p); W' etc. below."""
+        edges = self.mesh.edges
+        e = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, edges.size - 2)
+        seg_of = np.repeat(np.arange(self.mesh.n.size), self.mesh.n)[e]
+        h = self.mesh.h[seg_of]
+        xi = (x - edges[e]) / h
+        c = self.coef[:, e]  # (n, p, N+1, 4)
+        acc = c[:, :, -1]
+        for k in range(_TERMS - 1, -1, -1):
+            acc = acc * xi[None, :, None] + c[:, :, k]
+        EI = self.mesh.seg.EI[seg_of]
+        return acc[..., 0], acc[..., 1] / h, acc[..., 2] * EI / h**2, acc[..., 3] * EI / h**3
+
+    def derivative(self, x: np.ndarray, order: int) -> np.ndarray:
+        """``d^order W / dx^order`` (order 0..3) from the state and the field equations."""
+        W, Psi, M, V = self.state(x)
+        if order == 0:
+            return W
+        seg = self.mesh.seg
+        edges = self.mesh.edges
+        e = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, edges.size - 2)
+        j = np.repeat(np.arange(self.mesh.n.size), self.mesh.n)[e]
+        GA, EI, rhoA, rhoI = seg.GA[j], seg.EI[j], seg.rhoA[j], seg.rhoI[j]
+        w2 = (self.omega**2)[:, None]
+        d1 = Psi + V / GA
+        if order == 1:
+            return d1
+        if order == 2:
+            return M / EI - rhoA * w2 * W / GA
+        return -(V + rhoI * w2 * Psi) / EI - rhoA * w2 * d1 / GA
+
+
+def _shapes(mesh: Mesh, omegas: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """Series coefficients (n, elements, N+1, 4) of the null vectors at the roots."""
+    ne = int(mesh.n.sum())
+    out = np.zeros((omegas.size, ne, _TERMS + 1, 4))
+    seg_of = np.repeat(np.arange(mesh.n.size), mesh.n)
+    m = 0
+    while m < omegas.size:  # a cluster of (nearly) repeated roots shares one null space
+        q = m + 1
+        while q < omegas.size and omegas[q] - omegas[q - 1] <= 1e-7 * omegas[q]:
+            q += 1
+        om = float(np.mean(omegas[m:q]))
+        _, vec = mesh.eigen(om, int(index[m]), int(index[q - 1]))
+        P, T = mesh.transfer(om)
+        D = _scale(mesh.seg, mesh.h, mesh.ell, mesh.seg.lay.EI)
+        inv = np.linalg.inv(T[:, :2, 2:])
+        for i in range(q - m):
+            d = vec[:, i].reshape(-1, 2)
+            d = _rigid_dofs_zero(mesh, d)
+            d0, d1 = d[:-1], d[1:]  # (ne, 2)
+            s = seg_of
+            g0 = np.einsum("eab,eb->ea", inv[s], d1 - np.einsum("eab,eb->ea", T[s, :2, :2], d0))
+            y0 = np.concatenate([d0, g0], axis=1) / D[s]  # element-scaled state at each element's start
+            out[m + i] = np.einsum("enab,eb->ena", P[s], y0)
+        m = q
+    return out
+
+
+def _rigid_dofs_zero(mesh: Mesh, d: np.ndarray) -> np.ndarray:
+    """Zero the degrees of freedom held by rigid supports (their rows were decoupled)."""
+    lay = mesh.seg.lay
+    d = d.copy()
+    for node, g in enumerate(mesh.first_node):
+        if math.isinf(lay.k[node]):
+            d[g, 0] = 0.0
+        if math.isinf(lay.kt[node]):
+            d[g, 1] = 0.0
+    return d
+
+
+def solve(seg: Segments, n_needed: int, j0: int) -> TimoshenkoShapes:
+    """The first ``n_needed`` elastic modes above the ``j0`` rigid-body modes.
+
+    Brackets each root alone on the count (growing the bound with a mesh made
+    for it), then refines every root on one mesh valid up to the bound: the
+    eigenvalue of the bracket's index of the dynamic stiffness changes sign
+    there.
+    """
+    lay = seg.lay
+    c = math.sqrt(lay.EI / lay.rhoA)
+    bounds = bracket_wavenumbers(lambda beta: count_below(seg, beta * beta * c), lay, n_needed, j0)
+    if not bounds:
+        return TimoshenkoShapes(_mesh(seg, 0.0), np.zeros(0), np.zeros((0, 1, _TERMS + 1, 4)))
+    top = max(b[1] for b in bounds) ** 2 * c
+    mesh = _mesh(seg, top)
+    omegas = np.array([_refine(mesh, lo**2 * c, hi**2 * c, j) for lo, hi, j in bounds])
+    index = np.array([j for _, _, j in bounds])
+    return TimoshenkoShapes(mesh, omegas, _shapes(mesh, omegas, index))
+
+
+def _refine(mesh: Mesh, lo: float, hi: float, index: int) -> float:
+    """The root in (lo, hi): the ``index``-th eigenvalue of the dynamic stiffness crosses zero."""
+    from scipy.linalg import eigvals_banded
+
+    def f(omega: float) -> float:
+        return float(eigvals_banded(mesh.band(omega), lower=True, select="i", select_range=(index, index))[0])
+
+    flo, fhi = f(lo), f(hi)
+    if flo == 0.0:
+        return lo
+    if flo * fhi > 0.0:  # a repeated root at the end of its bracket
+        if abs(fhi) <= abs(flo):
+            return hi
+        raise ModeSolveError(f"Timoshenko modes: no sign change for root {index} in ({lo:g}, {hi:g}) rad/s")
+    return float(brentq(f, lo, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=200))
+
