@@ -259,36 +259,45 @@ def count_below(seg: Segments, omega: float) -> int:
 
 @dataclass(frozen=True, eq=False)
 class TimoshenkoShapes:
-    """Elastic mode shapes as a Taylor series per element (scaled state, see :func:`_series`)."""
+    """Elastic mode shapes as a Taylor series per element (scaled state, see :func:`_series`).
 
-    mesh: Mesh
+    Each mode has its own mesh, the coarsest valid at its frequency: a finer
+    one would make the dynamic stiffness, and so the null vector, needlessly
+    ill-conditioned (like a fine finite-element stiffness).
+    """
+
+    seg: Segments
     omega: np.ndarray  # (n,)
-    coef: np.ndarray  # (n, elements, N+1, 4)
+    meshes: tuple[Mesh, ...]  # per mode
+    coef: list[np.ndarray]  # per mode: (elements, N+1, 4)
+
+    def _locate(self, mesh: Mesh, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        edges = mesh.edges
+        e = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, edges.size - 2)
+        j = np.repeat(np.arange(mesh.n.size), mesh.n)[e]
+        return e, j, (x - edges[e]) / mesh.h[j]
 
     def state(self, x: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(W, Psi, M, V)`` per unit modal coordinate at ``x``: four arrays (n, p); W' etc. below."""
-        edges = self.mesh.edges
-        e = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, edges.size - 2)
-        seg_of = np.repeat(np.arange(self.mesh.n.size), self.mesh.n)[e]
-        h = self.mesh.h[seg_of]
-        xi = (x - edges[e]) / h
-        c = self.coef[:, e]  # (n, p, N+1, 4)
-        acc = c[:, :, -1]
-        for k in range(_TERMS - 1, -1, -1):
-            acc = acc * xi[None, :, None] + c[:, :, k]
-        EI = self.mesh.seg.EI[seg_of]
-        return acc[..., 0], acc[..., 1] / h, acc[..., 2] * EI / h**2, acc[..., 3] * EI / h**3
+        """``(W, Psi, M, V)`` per unit modal coordinate at ``x``: four arrays (n, p)."""
+        out = np.zeros((4, self.omega.size, x.size))
+        for m, (mesh, coef) in enumerate(zip(self.meshes, self.coef)):
+            e, j, xi = self._locate(mesh, x)
+            c = coef[e]  # (p, N+1, 4)
+            acc = c[:, -1]
+            for k in range(_TERMS - 1, -1, -1):
+                acc = acc * xi[:, None] + c[:, k]
+            h, EI = mesh.h[j], self.seg.EI[j]
+            out[:, m] = (acc[:, 0], acc[:, 1] / h, acc[:, 2] * EI / h**2, acc[:, 3] * EI / h**3)
+        return tuple(out)
 
     def derivative(self, x: np.ndarray, order: int) -> np.ndarray:
         """``d^order W / dx^order`` (order 0..3) from the state and the field equations."""
         W, Psi, M, V = self.state(x)
         if order == 0:
             return W
-        seg = self.mesh.seg
-        edges = self.mesh.edges
-        e = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, edges.size - 2)
-        j = np.repeat(np.arange(self.mesh.n.size), self.mesh.n)[e]
-        GA, EI, rhoA, rhoI = seg.GA[j], seg.EI[j], seg.rhoA[j], seg.rhoI[j]
+        nodes = self.seg.lay.nodes
+        j = np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2)
+        GA, EI, rhoA, rhoI = self.seg.GA[j], self.seg.EI[j], self.seg.rhoA[j], self.seg.rhoI[j]
         w2 = (self.omega**2)[:, None]
         d1 = Psi + V / GA
         if order == 1:
@@ -297,31 +306,33 @@ class TimoshenkoShapes:
             return M / EI - rhoA * w2 * W / GA
         return -(V + rhoI * w2 * Psi) / EI - rhoA * w2 * d1 / GA
 
+    def transform(self, T: np.ndarray) -> None:
+        """Replace the shapes by ``T @ shapes`` in place (T mixes only modes that share a mesh)."""
+        new = []
+        for a in range(T.shape[0]):
+            acc = np.zeros_like(self.coef[a])
+            for b in np.flatnonzero(T[a]):
+                if self.meshes[b] is not self.meshes[a]:
+                    raise AssertionError("modes on different meshes cannot be mixed")
+                acc += T[a, b] * self.coef[b]
+            new.append(acc)
+        self.coef[:] = new
 
-def _shapes(mesh: Mesh, omegas: np.ndarray, index: np.ndarray) -> np.ndarray:
-    """Series coefficients (n, elements, N+1, 4) of the null vectors at the roots."""
-    ne = int(mesh.n.sum())
-    out = np.zeros((omegas.size, ne, _TERMS + 1, 4))
-    seg_of = np.repeat(np.arange(mesh.n.size), mesh.n)
-    m = 0
-    while m < omegas.size:  # a cluster of (nearly) repeated roots shares one null space
-        q = m + 1
-        while q < omegas.size and omegas[q] - omegas[q - 1] <= 1e-7 * omegas[q]:
-            q += 1
-        om = float(np.mean(omegas[m:q]))
-        _, vec = mesh.eigen(om, int(index[m]), int(index[q - 1]))
-        P, T = mesh.transfer(om)
-        D = _scale(mesh.seg, mesh.h, mesh.ell, mesh.seg.lay.EI)
-        inv = np.linalg.inv(T[:, :2, 2:])
-        for i in range(q - m):
-            d = vec[:, i].reshape(-1, 2)
-            d = _rigid_dofs_zero(mesh, d)
-            d0, d1 = d[:-1], d[1:]  # (ne, 2)
-            s = seg_of
-            g0 = np.einsum("eab,eb->ea", inv[s], d1 - np.einsum("eab,eb->ea", T[s, :2, :2], d0))
-            y0 = np.concatenate([d0, g0], axis=1) / D[s]  # element-scaled state at each element's start
-            out[m + i] = np.einsum("enab,eb->ena", P[s], y0)
-        m = q
+
+def _null_space(mesh: Mesh, omega: float, first: int, last: int) -> list[np.ndarray]:
+    """Series coefficients of the null vectors ``first..last`` of the dynamic stiffness at a root."""
+    _, vec = mesh.eigen(omega, first, last)
+    P, T = mesh.transfer(omega)
+    D = _scale(mesh.seg, mesh.h, mesh.ell, mesh.seg.lay.EI)
+    inv = np.linalg.inv(T[:, :2, 2:])
+    s = np.repeat(np.arange(mesh.n.size), mesh.n)
+    out = []
+    for i in range(vec.shape[1]):
+        d = _rigid_dofs_zero(mesh, vec[:, i].reshape(-1, 2))
+        d0, d1 = d[:-1], d[1:]  # (elements, 2)
+        g0 = np.einsum("eab,eb->ea", inv[s], d1 - np.einsum("eab,eb->ea", T[s, :2, :2], d0))
+        y0 = np.concatenate([d0, g0], axis=1) / D[s]  # element-scaled state at each element's start
+        out.append(np.einsum("enab,eb->ena", P[s], y0))
     return out
 
 
@@ -340,21 +351,37 @@ def _rigid_dofs_zero(mesh: Mesh, d: np.ndarray) -> np.ndarray:
 def solve(seg: Segments, n_needed: int, j0: int) -> TimoshenkoShapes:
     """The first ``n_needed`` elastic modes above the ``j0`` rigid-body modes.
 
-    Brackets each root alone on the count (growing the bound with a mesh made
-    for it), then refines every root on one mesh valid up to the bound: the
+    Brackets each root alone on the count, narrows the bracket to 5 %, and
+    refines the root on the coarsest mesh valid up to the bracket's top: the
     eigenvalue of the bracket's index of the dynamic stiffness changes sign
-    there.
+    there. Shapes are the null vectors on that mesh.
     """
     lay = seg.lay
     c = math.sqrt(lay.EI / lay.rhoA)
     bounds = bracket_wavenumbers(lambda beta: count_below(seg, beta * beta * c), lay, n_needed, j0)
-    if not bounds:
-        return TimoshenkoShapes(_mesh(seg, 0.0), np.zeros(0), np.zeros((0, 1, _TERMS + 1, 4)))
-    top = max(b[1] for b in bounds) ** 2 * c
-    mesh = _mesh(seg, top)
-    omegas = np.array([_refine(mesh, lo**2 * c, hi**2 * c, j) for lo, hi, j in bounds])
-    index = np.array([j for _, _, j in bounds])
-    return TimoshenkoShapes(mesh, omegas, _shapes(mesh, omegas, index))
+    omegas, meshes = [], []
+    for lo, hi, j in bounds:
+        lo, hi = lo * lo * c, hi * hi * c
+        while hi - lo > 0.05 * hi:
+            mid = 0.5 * (lo + hi)
+            if count_below(seg, mid) > j:
+                hi = mid
+            else:
+                lo = mid
+        meshes.append(_mesh(seg, hi))
+        omegas.append(_refine(meshes[-1], lo, hi, j))
+    index = [j for _, _, j in bounds]
+    coef: list[np.ndarray] = []
+    m = 0
+    while m < len(omegas):  # a cluster of (nearly) repeated roots shares one null space and mesh
+        q = m + 1
+        while q < len(omegas) and omegas[q] - omegas[q - 1] <= 1e-7 * omegas[q]:
+            q += 1
+        for i in range(m + 1, q):
+            meshes[i] = meshes[m]
+        coef.extend(_null_space(meshes[m], float(np.mean(omegas[m:q])), index[m], index[q - 1]))
+        m = q
+    return TimoshenkoShapes(seg, np.array(omegas, dtype=float), tuple(meshes), coef)
 
 
 def _refine(mesh: Mesh, lo: float, hi: float, index: int) -> float:

@@ -61,7 +61,7 @@ from ._exact import (
     _basis,
     bracket_roots,
     characteristic,
-    count_below,
+    count_below as _count_below_eb,
     krylov_mask,
     layout,
     null_vector,
@@ -249,7 +249,7 @@ class ModeSet:
         if self._timo is not None and self._timo.omega.size:
             from ._timoshenko import wavenumbers
 
-            return float(wavenumbers(self._timo.mesh.seg, float(self._timo.omega.max()))[0].max())
+            return float(wavenumbers(self._timo.seg, float(self._timo.omega.max()))[0].max())
         return float(self.beta.max(initial=1.0 / self.beam.length) * np.max(self._layout.r))
 
     @functools.cached_property
@@ -339,6 +339,26 @@ class ModeSet:
         return force * self.shapes([position])[:, 0] / self.omega**2
 
 
+def count_below(beam: Beam, omega: float, springs: Sequence[tuple[float, float]] = ()) -> int:
+    """Number of natural frequencies strictly below ``omega`` [rad/s] (Wittrick-Williams).
+
+    Rigid-body modes count as frequencies at zero. For a Timoshenko beam both
+    spectra count (above the cut-off ``sqrt(kappa G A / rho I)`` too).
+
+    Parameters
+    ----------
+    beam : Beam
+    omega : float, [rad/s]
+    springs : sequence of (position, stiffness)
+        Engaged contact springs, [m] and [N/m].
+    """
+    if beam.is_timoshenko:
+        from . import _timoshenko
+
+        return _timoshenko.count_below(_timoshenko.segments(beam, layout(beam, springs)), float(omega))
+    return _count_below_eb(beam, omega, springs)
+
+
 def _clusters(betas: np.ndarray) -> list[tuple[int, int]]:
     """Index ranges ``[i, j)`` of (nearly) repeated roots."""
     out, i = [], 0
@@ -410,7 +430,7 @@ def _normalise(ms: ModeSet, groups: list[tuple[int, int]]) -> None:
     scale[r:] *= np.sign(W[np.arange(W.shape[0]), idx])
     T = (scale[:, None] * mix)[r:, r:]
     if ms._timo is not None:
-        ms._timo.coef[...] = np.einsum("ab,bekc->aekc", T, ms._timo.coef)
+        ms._timo.transform(T)
     else:
         ms._coef[r:] = np.einsum("ab,bsk->ask", T, ms._coef[r:])
 
