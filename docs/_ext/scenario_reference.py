@@ -79,11 +79,14 @@ MEANING: dict[str, str] = {
     "springs[].position_ratio": "The same as a fraction of L.",
     "springs[].translational": "Its translational stiffness [N/m] (`inf`: a rigid prop).",
     "springs[].rotational": "Its rotational stiffness [N m/rad] (`inf`: no rotation there).",
-    "beam.theory": '`"euler-bernoulli"` (default, the paper\'s beam). `"timoshenko"` is refused with a clear message '
-                   "in this version.",
-    "beam.poisson_ratio": "Timoshenko beams only (refused otherwise).",
-    "beam.shear_modulus": "Timoshenko beams only (refused otherwise).",
-    "beam.shear_coefficient": "Timoshenko beams only (refused otherwise).",
+    "beam.theory": '`"euler-bernoulli"` (default, the paper\'s beam) or `"timoshenko"` (shear deformation and '
+                   "rotary inertia; exact modes in both frequency regimes).",
+    "beam.poisson_ratio": "Timoshenko beams: Poisson's ratio in (-1, 0.5); G = E / (2 (1 + nu)) in every section "
+                          "(refused on an Euler-Bernoulli beam).",
+    "beam.shear_modulus": "Timoshenko beams: instead of `poisson_ratio`, G [Pa] of the `[beam]` values "
+                          "(nu = E / 2G - 1 must lie in (-1, 0.5)).",
+    "beam.shear_coefficient": "Timoshenko beams: kappa; default Cowper's value for a rectangle, "
+                              "10 (1 + nu) / (12 + 11 nu) (required for a section given as area and second moment).",
     "output.points": "Positions [m] where the response is recorded (list).",
     "output.point_ratios": "The same as fractions of L (instead of `points`).",
     "output.fields": "Fields of result files: `displacement` and `velocity` (always written), `moment` [N m] "
