@@ -585,13 +585,14 @@ def test_common_unit_table_agrees_with_pint():
 @pytest.mark.parametrize(
     ("values", "key"),
     [
-        ({"beam.theory": "timoshenko"}, "beam.theory"),
+        ({"beam.theory": "timoshenko"}, "beam.poisson_ratio"),  # a Timoshenko beam needs it
         ({"beam.theory": "rayleigh"}, "beam.theory"),
         ({"beam.shear_coefficient": 0.85}, "beam.shear_coefficient"),
     ],
 )
 def test_beam_theory_is_euler_bernoulli_or_refused_by_name(values: dict, key: str) -> None:
-    # Reason: a Timoshenko request must not be ignored (the beam would silently stay Euler-Bernoulli)
+    # Reason: a theory or a Timoshenko key must never be ignored (the beam would silently stay
+    # Euler-Bernoulli): unknown theories and shear keys on an Euler-Bernoulli beam are refused
     sc = parse_scenario(tomllib.loads(BEAM))
     assert sc.with_values({"beam.theory": "euler-bernoulli"}).beam == sc.beam
     with pytest.raises(ScenarioError) as err:

@@ -391,6 +391,7 @@ def test_modes_cli_json_and_plot_of_a_structure(tmp_path):
         "section_steps": [0.4],
         "masses": [{"position": 1.0, "mass": 0.05, "rotary_inertia": 1e-6}],
         "springs": [{"position": 0.5, "translational": 1e4, "rotational": "inf"}],
+        "theory": "euler-bernoulli",
     }
     assert png.stat().st_size > 1000
     # the table names the structure

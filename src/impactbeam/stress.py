@@ -53,7 +53,7 @@ def _moment_rows(modes: Any, x: np.ndarray, bending_stiffness: float) -> np.ndar
 @functools.lru_cache(maxsize=256)
 def _static_moment_coefficients(beam: Any, alpha: float, distributed: bool) -> np.ndarray:
     """Polynomial coefficients (2, m) of ``ghat''`` for a unit point force at ``xi = alpha`` or a unit uniform load."""
-    from .solver.ritz import static_polynomial
+    from .solver.statics import static_polynomial
 
     if distributed:
         coef = static_polynomial(beam, 0.5, np.array([[1.0], [1.0]]), 0.0)

@@ -263,18 +263,28 @@ class Beam:
         """True for a Timoshenko beam (``theory = "timoshenko"``)."""
         return self.theory == "timoshenko"
 
+    def _nu(self) -> float:
+        if self.poisson_ratio is None:
+            raise ParameterError("beam.poisson_ratio: not given (only a Timoshenko beam has a shear stiffness)")
+        return float(self.poisson_ratio)
+
     @property
     def kappa(self) -> float:
         """Shear coefficient: the given one, else Cowper's for a rectangle ``10 (1 + nu) / (12 + 11 nu)``."""
         if self.shear_coefficient is not None:
             return float(self.shear_coefficient)
-        nu = 0.3 if self.poisson_ratio is None else self.poisson_ratio
+        nu = self._nu()
         return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
 
     def shear_stiffness(self, piece: Section) -> float:
-        """``kappa G A`` of one piece [N], ``G = E / (2 (1 + nu))``."""
-        nu = 0.3 if self.poisson_ratio is None else self.poisson_ratio
-        return self.kappa * piece.youngs_modulus / (2.0 * (1.0 + nu)) * piece.area
+        """``kappa G A`` of one piece [N], ``G = E / (2 (1 + nu))`` (Timoshenko beams).
+
+        Parameters
+        ----------
+        piece : Section
+            One of :meth:`pieces`.
+        """
+        return self.kappa * piece.youngs_modulus / (2.0 * (1.0 + self._nu())) * piece.area
 
     @classmethod
     def rectangular(

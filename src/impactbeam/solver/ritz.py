@@ -8,9 +8,8 @@ switch: ``N`` modes cannot represent the local deformation under the spring
 (Melcher, Champneys & Wagg 2013), the energy jumps and the impact sequence
 does not converge.
 
-Here all states are integrated in ONE basis of ``N + n_a`` functions
-(``n_a`` = number of distinct contactor positions, normally the number of
-contactors):
+Here all states are integrated in ONE basis of ``N + n_r`` functions
+(``n_r`` residual functions, normally one per contactor):
 
 * the ``N`` retained modes ``phi_i`` of the free state (paper eq. 5-7);
 * one static attachment (residual-flexibility) shape per contactor position
@@ -22,12 +21,24 @@ contactors):
   every retained mode; the ``r_a`` are mass-orthonormalised among themselves
   and diagonalise the free stiffness (pseudo-frequencies above ``omega_N``).
 
+* when these do not give the first ``N`` frequencies of the state with every
+  contactor engaged to ``1e-4`` (a stop much stiffer than the beam there,
+  e.g. at a free end: those modes reach above the retained band), that
+  state's first ``N`` exact modes ``psi_j`` as well, each through its part
+  outside the retained modes, ``psi_j - sum_i P_ij phi_i`` with
+  ``P = <phi, psi>`` (paper eq. 12). Every state's lowest ``N`` modes are then
+  in the basis, as in the paper's method, which keeps ``N`` per state. Their
+  free stiffness follows from modal identities, ``K psi = K_s psi - sum k
+  psi(a) delta_a``. A direction with less than 1e-3 of its norm outside the
+  others is left out (it would amplify round-off); supported beams only (the
+  free state has no rigid-body mode).
+
 In that basis (mass matrix the identity) the stiffness of every state is exact
 in the reduced coordinates,
 ``K_s = diag(omega^2, lambda_r) + sum_engaged k_c psi(a_c) psi(a_c)^T``,
 and the gap adds the constant force ``s k c psi(a_c)`` (paper eqs. 8-9). The
 modes of a state are the eigenvectors ``Phi_s`` of that small symmetric
-eigenproblem, so each state still has ``N + n_a`` uncoupled modal equations
+eigenproblem, so each state still has ``N + n_r`` uncoupled modal equations
 integrated in closed form; a switch is the exact change of coordinates
 ``eta_new = Phi_new^T Phi_old eta_old`` (orthogonal: no loss, displacement,
 velocity and energy continuous to round-off) instead of eq. (12).
@@ -60,97 +71,24 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
+import scipy.linalg
 
 from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
 from ..model.loading import Excitation, InitialCondition, spatial_projection
-from ..modal import mode_set
+from ..modal import ModeSet, mode_set
 from ..model import Damping
 from .states import ModalDynamics, StateModel
+from .statics import static_coefficients
 
-__all__ = ["RitzBasis", "RitzModes", "RitzStateSpace", "ritz_basis", "static_polynomial"]
+__all__ = ["RitzBasis", "RitzModes", "RitzStateSpace", "ritz_basis"]
 
 _MERGE = 3e-5  # contactors closer than this fraction of L share one attachment shape
 _DROP = 1e-11  # a residual shape smaller than this fraction of its static shape is dropped
 _LOSSY = 1e-12  # below this fraction the residual keeps fewer than ~4 digits (cancellation): warn
+_NEW = 1e-3  # a contact-state mode must bring at least this fraction of its norm outside the basis
+_UNION = 1e-4  # the engaged state's first N frequencies must come out this close, else its modes join
 _GX, _GW = np.polynomial.legendre.leggauss(20)
-
-
-# --------------------------------------------------------------------------- static shapes
-
-
-def _bc_rows(beam: Beam) -> tuple[np.ndarray, np.ndarray]:
-    """Weights of the end conditions on (g, g', g'', g''') in ``xi = x / L``, ``g = L^3/EI ghat``.
-
-    Rows ``(p, 0, 0, q)`` etc. with ``p = K/(K + scale)``: exact for K = 0 and inf.
-    """
-    L, EI = beam.length, beam.bending_stiffness
-
-    def w(K: float, scale: float) -> tuple[float, float]:
-        return (1.0, 0.0) if math.isinf(K) else (K / (K + scale), scale / (K + scale))
-
-    p1, q1 = w(beam.left.translational, EI / L**3)
-    t1, u1 = w(beam.left.rotational, EI / L)
-    p2, q2 = w(beam.right.translational, EI / L**3)
-    t2, u2 = w(beam.right.rotational, EI / L)
-    left = np.array([[p1, 0.0, 0.0, q1], [0.0, t1, -u1, 0.0]])  # k1 g + EI g''' = 0 ; Kt1 g' - EI g'' = 0
-    right = np.array([[p2, 0.0, 0.0, -q2], [0.0, t2, u2, 0.0]])  # k2 g - EI g''' = 0 ; Kt2 g' + EI g'' = 0
-    return left, right
-
-
-def _cubic_derivs(xi: float) -> np.ndarray:
-    """Rows d^k/dxi^k of (1, xi, xi^2, xi^3) for k = 0..3, shape (4, 4)."""
-    return np.array([
-        [1.0, xi, xi**2, xi**3],
-        [0.0, 1.0, 2 * xi, 3 * xi**2],
-        [0.0, 0.0, 2.0, 6 * xi],
-        [0.0, 0.0, 0.0, 6.0],
-    ])
-
-
-def static_polynomial(beam: Beam, alpha: float, loads: np.ndarray, jump: float) -> np.ndarray:
-    """Coefficients (2 segments, powers of xi) of ``ghat`` with ``ghat'''' = loads[s](xi)`` on each side.
-
-    ``loads`` (2, m) holds the polynomial load of the segments left and right
-    of ``xi = alpha``; ``jump`` is ``ghat'''(alpha+) - ghat'''(alpha-)`` (1 for a
-    unit point force there, 0 for none); ``ghat, ghat', ghat''`` are continuous;
-    end conditions of DESIGN.md section 1. A singular system (rigid-body motion)
-    is solved in the least-squares sense; the caller removes the rigid-body part.
-    """
-    m = loads.shape[1]
-    part = np.zeros((2, m + 4))
-    for k in range(m):  # four integrations of xi^k
-        part[:, k + 4] = loads[:, k] * math.factorial(k) / math.factorial(k + 4)
-    dpart = [[np.polynomial.polynomial.polyder(part[s], k) if k else part[s] for k in range(4)] for s in (0, 1)]
-
-    def pd(side: int, xi: float) -> np.ndarray:
-        return np.array([np.polynomial.polynomial.polyval(xi, d) for d in dpart[side]])
-
-    left, right = _bc_rows(beam)
-    A = np.zeros((8, 8))
-    b = np.zeros(8)
-    A[0:2, 0:4] = left @ _cubic_derivs(0.0)
-    b[0:2] = -left @ pd(0, 0.0)
-    D = _cubic_derivs(alpha)
-    A[2:6, 0:4] = D
-    A[2:6, 4:8] = -D
-    b[2:6] = pd(1, alpha) - pd(0, alpha)
-    b[5] -= jump  # g'''(a-) - g'''(a+) = -jump
-    A[6:8, 4:8] = right @ _cubic_derivs(1.0)
-    b[6:8] = -right @ pd(1, 1.0)
-    c, *_ = np.linalg.lstsq(A, b, rcond=1e-13)
-    out = part.copy()
-    out[0, :4] += c[:4]
-    out[1, :4] += c[4:]
-    return out
-
-
-def _static_coefficients(beam: Beam, alpha: float, q0: float, q1: float) -> np.ndarray:
-    """Coefficients (2, 6) of ``ghat`` under a unit force at ``xi = alpha`` with ``ghat'''' = q0 + q1 xi``.
-
-    The load is the inertia relief of rigid-body modes (zero without them).
-    """
-    return static_polynomial(beam, alpha, np.array([[q0, q1], [q0, q1]]), 1.0)
 
 
 # --------------------------------------------------------------------------- the basis
@@ -165,14 +103,16 @@ class RitzBasis:
         The ``N`` retained modes of the free state.
     positions : ndarray, (n_a,)
         Distinct contactor positions that received an attachment shape.
-    lam : ndarray, (N + n_a,)
+    lam : ndarray, (N + n_r,)
         Free-state stiffness in the basis (diagonal): ``omega_i^2``, then the
-        residual shapes' ``lambda_r``.
+        residual functions' ``lambda_r``.
     count : int
-        ``N + n_a``.
+        ``N + n_r``: one residual function per contactor position, plus those
+        of the engaged state's modes when they join.
     """
 
-    def __init__(self, beam: Beam, positions: Sequence[float], n_modes: int) -> None:
+    def __init__(self, beam: Beam, positions: Sequence[float], n_modes: int,
+                 contact: Sequence[tuple[float, float]] = ()) -> None:
         self.beam = beam
         self.free = mode_set(beam, (), n_modes)
         L = beam.length
@@ -181,19 +121,42 @@ class RitzBasis:
             if not pos or a - pos[-1] > _MERGE * L:
                 pos.append(a)
         self._alpha = np.array(pos) / L
-        self._x, self._w = self._quadrature()
-        rhoA = beam.mass_per_length
+        self._contact: ModeSet | None = None
+        # the engaged state's modes may join (supported beams only: with rigid-body modes the
+        # inertia-relief attachment shapes are not K-orthogonal to them in the same sense)
+        engaged = mode_set(beam, contact, n_modes) if contact and pos and not self.free.n_rigid else None
+        self._x, self._w = self._quadrature(engaged)
+        self._keep_attachments()
+        self.positions = self._alpha * L
+        self._P = np.zeros((self.free.count, 0))
+        self._C = np.zeros((self.free.count, 0))
+        lr = np.zeros(0)
+        self._Z = np.zeros((0, 0))
+        if self._alpha.size:
+            lr = self._orthonormalise(())
+            if engaged is not None and self._misses_contact_modes(lr, contact, engaged):
+                self._contact = engaged
+                self._P = self.free.overlap(engaged)
+                self._C = np.zeros((self.free.count, 0))
+                lr = self._orthonormalise(contact)
+        self.lam = np.concatenate([self.free.omega**2, lr])
+        self.count = int(self.lam.size)
+        self.integral = (self.values(self._x) @ self._w)
+        self.integral.setflags(write=False)
+
+    def _keep_attachments(self) -> None:
+        """Second Gram-Schmidt pass on the attachment shapes; drop those the retained modes already hold."""
+        rhoA, L = self.beam.mass_per_length, self.beam.length
         Rq = self._residuals_at(self._x, 0)  # (n_c, q)
         if self._alpha.size and self.free.count > self.free.n_rigid:
-            # second Gram-Schmidt pass: r_c is a small difference of O(1) shapes
-            # (~N^-3.5 of g_c), so remove what round-off left along the retained modes
+            # r_c is a small difference of O(1) shapes (~N^-3.5 of g_c), so remove
+            # what round-off left along the retained modes
             Fq = self.free.shapes(self._x)[self.free.n_rigid :]
             self.__dict__["_modal_static"] = self._modal_static + rhoA * (Fq * self._w) @ Rq.T
             Rq = self._residuals_at(self._x, 0)
-        Mrr = rhoA * (Rq * self._w) @ Rq.T
         gq = self._static_at(self._x, 0)
         g_norm = np.sqrt(rhoA * (gq**2) @ self._w)
-        r_norm = np.sqrt(np.maximum(np.diag(Mrr), 0.0))
+        r_norm = np.sqrt(rhoA * (Rq**2) @ self._w)
         keep = r_norm > _DROP * g_norm
         lossy = keep & (r_norm < _LOSSY * g_norm)
         if lossy.any():
@@ -202,36 +165,103 @@ class RitzBasis:
                 f"{float((r_norm / g_norm)[lossy].min()):.2g} of its static shape (very soft supports?): it keeps "
                 "fewer than 4 significant digits; consider solver.basis = 'paper'",
                 RuntimeWarning,
-                stacklevel=3,
+                stacklevel=4,
             )
         if not keep.all():
             self._alpha = self._alpha[keep]
-            self.__dict__.pop("_static", None)
-            self.__dict__.pop("_static_q", None)
-            self.__dict__.pop("_modal_static", None)
-        Mrr = Mrr[np.ix_(keep, keep)]
-        self.positions = self._alpha * L
-        n_a = int(keep.sum())
-        if n_a:
-            Ra = self._residuals_at(self.positions, 0)  # (n_a, n_a): r_c(a_d)
-            Krr = 0.5 * (Ra + Ra.T)
-            s, U = np.linalg.eigh(Mrr)
-            ok = s > 1e-10 * s.max()
-            Y = U[:, ok] / np.sqrt(s[ok])
-            lr, V = np.linalg.eigh(Y.T @ Krr @ Y)
-            self._Z = Y @ V  # r-combination -> orthonormal residual shapes
-        else:
-            lr = np.zeros(0)
-            self._Z = np.zeros((0, 0))
-        self.lam = np.concatenate([self.free.omega**2, lr])
-        self.count = int(self.lam.size)
-        self.integral = (self.values(self._x) @ self._w)
-        self.integral.setflags(write=False)
+            for name in ("_static", "_static_q", "_modal_static"):
+                self.__dict__.pop(name, None)
 
-    def _quadrature(self) -> tuple[np.ndarray, np.ndarray]:
-        """Gauss-Legendre (20 points) on pieces of at most half the shortest retained wavelength, split at the contactors."""
+    def _misses_contact_modes(self, lr: np.ndarray, contact: Sequence[tuple[float, float]], engaged: ModeSet) -> bool:
+        """Whether this basis gives the first N frequencies of the ``engaged`` state worse than ``_UNION``.
+
+        Rayleigh-Ritz in the basis (free modes, attachment shapes) against the
+        exact modes of the state with every ``contact`` spring engaged.
+        """
+        lam = np.concatenate([self.free.omega**2, lr])
+        xs = [x for x, _ in contact]
+        at = np.concatenate([self.free.shapes(xs), self._Z.T @ self._extra_at(np.asarray(xs, dtype=float), 0)])
+        K = np.diag(lam) + sum(k * np.outer(at[:, j], at[:, j]) for j, (_, k) in enumerate(contact))
+        exact = engaged.omega
+        ritz = np.sqrt(np.maximum(np.linalg.eigvalsh(0.5 * (K + K.T)), 0.0))[: exact.size]
+        scale = max(float(exact.max(initial=0.0)), 1e-300)
+        return bool(np.max(np.abs(ritz - exact[: ritz.size]) / np.maximum(exact[: ritz.size], 1e-9 * scale)) > _UNION)
+
+    def _extra_at(self, x: np.ndarray, derivative: int) -> np.ndarray:
+        """The residual functions before orthonormalisation: attachment shapes, then ``psi_j - sum_i P_ij phi_i``."""
+        R = self._residuals_at(x, derivative)
+        if self._contact is not None:
+            F = self.free.shapes(x, derivative)
+            R = np.concatenate([R, self._contact.shapes(x, derivative) - self._P.T @ F])
+        if self._C.shape[1]:
+            R = R - self._C.T @ self.free.shapes(x, derivative)
+        return R
+
+    def _extra_stiffness(self, contact: Sequence[tuple[float, float]]) -> np.ndarray:
+        """Free-state stiffness ``<f, K f>`` of the residual functions, exact from the modal data.
+
+        ``r_c^T K r_d = r_c(a_d)``; with the contact-state modes ``psi`` (springs
+        ``k_s`` at ``a_s`` engaged), ``K psi = K_s psi - sum_s k_s psi(a_s) delta_s``:
+        ``psi~^T K psi~ = Omega_c^2 - sum_s k_s psi(a_s) psi(a_s)^T - P^T Omega^2 P`` and
+        ``r_c^T K psi~ = psi(a_c) - P^T phi(a_c)``. Every residual function is
+        K-orthogonal to the retained modes.
+        """
+        Ra = self._residuals_at(self.positions, 0)
+        K = 0.5 * (Ra + Ra.T)
+        if self._contact is None:
+            return K
+        cm, P = self._contact, self._P
+        xs = np.array([x for x, _ in contact], dtype=float)
+        ks = np.array([k for _, k in contact], dtype=float)
+        psa = cm.shapes(xs)
+        Kpp = np.diag(cm.omega**2) - (psa * ks) @ psa.T - P.T @ (self.free.omega[:, None] ** 2 * P)
+        K1p = (cm.shapes(self.positions) - P.T @ self.free.shapes(self.positions)).T
+        return np.block([[K, K1p], [K1p.T, 0.5 * (Kpp + Kpp.T)]])
+
+    def _orthonormalise(self, contact: Sequence[tuple[float, float]]) -> np.ndarray:
+        """Mass-orthonormal residual functions that diagonalise the free stiffness; returns their ``lambda_r``.
+
+        On the quadrature the weighted functions are projected out of the
+        retained modes twice (classical Gram-Schmidt; the coefficients are kept
+        in ``_C``), then orthonormalised by a column-pivoted QR; a direction
+        whose part outside the earlier ones is below ``_NEW`` of its norm (a
+        contact-state mode the free modes already hold) is dropped, so no
+        combination amplifies round-off by more than ``1 / _NEW``.
+        """
+        sw = np.sqrt(self.beam.mass_per_length * self._w)
+        F = (self.free.shapes(self._x) * sw).T  # (q, N), orthonormal columns
+        B = (self._extra_at(self._x, 0) * sw).T
+        C = np.zeros((F.shape[1], B.shape[1]))
+        for _ in range(2):
+            c = F.T @ B
+            B = B - F @ c
+            C += c
+        self._C = C
+        norm = np.linalg.norm(B, axis=0)
+        n_a = self._alpha.size
+        # a contact-state mode (unit norm) that the free modes hold to _NEW (one the
+        # springs do not move, e.g. antisymmetric about a stop) is left out: what remains
+        # of it is round-off
+        cols = np.flatnonzero((np.arange(B.shape[1]) < n_a) | (norm > _NEW))
+        d = 1.0 / norm[cols]
+        _, Rt, piv = scipy.linalg.qr(B[:, cols] * d, mode="economic", pivoting=True)
+        k = int(np.sum(np.abs(np.diag(Rt)) > _NEW))
+        Y = np.zeros((B.shape[1], k))
+        Y[cols[piv[:k]]] = d[piv[:k], None] * np.linalg.inv(Rt[:k, :k])
+        K = self._extra_stiffness(contact) + C.T @ (self.free.omega[:, None] ** 2 * C)
+        lr, V = np.linalg.eigh(Y.T @ K @ Y)
+        self._Z = Y @ V
+        return lr
+
+    def _quadrature(self, engaged: ModeSet | None) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Legendre (20 points) on pieces of at most half the shortest retained wavelength, split at the contactors.
+
+        The wavelengths are those of the free modes and of the ``engaged`` state's modes.
+        """
         L = self.beam.length
         bmax = max(float(self.free.beta.max(initial=0.0)), 4.0 / L)
+        if engaged is not None:
+            bmax = max(bmax, float(engaged.beta.max(initial=0.0)))
         breaks = np.unique(np.concatenate([[0.0, L], self._alpha * L]))
         xs, ws = [], []
         for a, b in zip(breaks[:-1], breaks[1:]):
@@ -260,7 +290,7 @@ class RitzBasis:
                 c1 = (ph[:, 1] - ph[:, 0])  # per unit xi
                 q0 = -L * beam.mass_per_length * float(c0 @ pa)
                 q1 = -L * beam.mass_per_length * float(c1 @ pa)
-            out.append(_static_coefficients(beam, float(al), q0, q1))
+            out.append(static_coefficients(beam, float(al), q0, q1))
         return out
 
     def _static_at(self, x: np.ndarray, derivative: int) -> np.ndarray:
@@ -316,23 +346,26 @@ class RitzBasis:
         return g - self._modal_static.T @ self.free.shapes(x, derivative)[r:]
 
     def values(self, x: float | Sequence[float] | np.ndarray, derivative: int = 0) -> np.ndarray:
-        """The ``N + n_a`` basis functions (or x-derivatives, 0..3) at ``x``: shape (n, p)."""
+        """The ``N + n_r`` basis functions (or x-derivatives, 0..3) at ``x``: shape (n, p)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         out = self.free.shapes(x, derivative)
         if self._Z.size:
-            R = self._residuals_at(x, derivative)
-            out = np.concatenate([out, self._Z.T @ R])
+            out = np.concatenate([out, self._Z.T @ self._extra_at(x, derivative)])
         return out
 
 
 @functools.lru_cache(maxsize=64)
-def _cached_basis(beam: Beam, positions: tuple[float, ...], n_modes: int) -> RitzBasis:
-    return RitzBasis(beam, positions, n_modes)
+def _cached_basis(beam: Beam, positions: tuple[float, ...], n_modes: int,
+                  contact: tuple[tuple[float, float], ...]) -> RitzBasis:
+    return RitzBasis(beam, positions, n_modes, contact)
 
 
-def ritz_basis(beam: Beam, positions: Sequence[float], n_modes: int) -> RitzBasis:
-    """The shared basis of ``n_modes`` free modes and the attachment shapes at ``positions`` (cached)."""
-    return _cached_basis(beam, tuple(sorted(float(p) for p in positions)), int(n_modes))
+def ritz_basis(beam: Beam, positions: Sequence[float], n_modes: int,
+               contact: Sequence[tuple[float, float]] = ()) -> RitzBasis:
+    """The shared basis of ``n_modes`` free modes, the attachment shapes at ``positions`` and (with
+    ``contact``, the engaged springs as (position, stiffness)) that contact state's modes (cached)."""
+    key = tuple(sorted((float(x), float(k)) for x, k in contact))
+    return _cached_basis(beam, tuple(sorted(float(p) for p in positions)), int(n_modes), key)
 
 
 # --------------------------------------------------------------------------- state modes
@@ -344,8 +377,8 @@ class RitzModes:
     Offers the part of :class:`~impactbeam.modal.ModeSet`'s interface the
     solver and the results use (``omega``, ``count``, ``frequencies_hz``,
     ``shapes``, ``integral``). They are mass-orthonormal
-    (``rho A int W_n W_m dx = delta_nm``) and there are ``N + n_a`` of them:
-    the approximation of the state's lowest ``N + n_a`` modes (Rayleigh-Ritz).
+    (``rho A int W_n W_m dx = delta_nm``) and there are ``N + n_r`` of them:
+    the approximation of the state's lowest ``N + n_r`` modes (Rayleigh-Ritz).
     """
 
     def __init__(self, basis: RitzBasis, Phi: np.ndarray, omega: np.ndarray) -> None:
@@ -356,7 +389,7 @@ class RitzModes:
 
     @property
     def count(self) -> int:
-        """Number of modes, ``N + n_a``."""
+        """Number of modes, ``N + n_r``."""
         return int(self.omega.size)
 
     @property
@@ -412,9 +445,9 @@ def _state_eigen(basis: RitzBasis, springs: Sequence[tuple[int, float]], at: np.
 class RitzStateSpace:
     """Drop-in for :class:`~impactbeam.solver.states.StateSpace` on the shared Ritz basis.
 
-    Every state has ``N + n_a`` modes (``N = n_modes`` retained free modes,
-    ``n_a`` = number of distinct contactor positions, normally the number of
-    contactors); :attr:`count` gives it. ``transfer`` is the exact change of
+    Every state has ``N + n_r`` modes (``N = n_modes`` retained free modes,
+    ``n_r`` residual functions, normally one per contactor position);
+    :attr:`count` gives it. ``transfer`` is the exact change of
     coordinates between two states (orthogonal), not the projection of eq. (12).
     """
 
@@ -440,7 +473,7 @@ class RitzStateSpace:
                     f"contactors.{i}.stiffness: a rigid stop cannot be integrated in the enriched basis "
                     "(solver.basis); give a finite stiffness"
                 )
-        self.basis = ritz_basis(beam, self.positions, n_modes)
+        self.basis = ritz_basis(beam, self.positions, n_modes, [(c.position, c.stiffness) for c in self.contactors])
         self._psi_c = self.basis.values(self.positions) if self.contactors else np.zeros((self.basis.count, 0))
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
         self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length)
@@ -449,7 +482,7 @@ class RitzStateSpace:
 
     @property
     def count(self) -> int:
-        """Modes per state, ``N + n_a``."""
+        """Modes per state, ``N + n_r``."""
         return self.basis.count
 
     def state(self, engaged: tuple[int, ...]) -> StateModel:
