@@ -19,14 +19,14 @@ same instant (piecewise polynomial). The truncated modal sum then only carries
 the dynamic part, which converges fast; at a static limit the moment is exact
 for any number of modes.
 
-The static moment is exact for uniform beams whose supports hold them
-(no rigid-body motion). Otherwise the plain modal sum is returned with a
-warning.
+The static moment (:mod:`impactbeam._static`) is exact for every beam of the
+model its supports hold (sections, springs, point masses, Timoshenko). A beam
+that can move as a rigid body has no static solution: the plain modal sum is
+returned with a warning.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 import warnings
 from collections.abc import Sequence
@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._static import static_moment
 from ._warnings import emit_user_level_warning
 from .exceptions import ImpactBeamWarning
 
@@ -50,39 +51,22 @@ def _moment_rows(modes: Any, x: np.ndarray, bending_stiffness: float) -> np.ndar
     return bending_stiffness * np.asarray(modes.shapes(x, 2), dtype=float)
 
 
-@functools.lru_cache(maxsize=256)
-def _static_moment_coefficients(beam: Any, alpha: float, distributed: bool) -> np.ndarray:
-    """Polynomial coefficients (2, m) of ``ghat''`` for a unit point force at ``xi = alpha`` or a unit uniform load."""
-    from .solver.statics import static_polynomial
-
-    if distributed:
-        coef = static_polynomial(beam, 0.5, np.array([[1.0], [1.0]]), 0.0)
-    else:
-        coef = static_polynomial(beam, alpha, np.zeros((2, 1)), 1.0)
-    return np.array([np.polynomial.polynomial.polyder(c, 2) for c in coef])
-
-
-def _static_moment(beam: Any, x: np.ndarray, position: float | None) -> np.ndarray:
-    """Static moment [N m] at ``x`` under a unit point force at ``position`` [N], or a unit uniform load [N/m] (None)."""
-    L = beam.length
-    xi = x / L
-    if position is None:
-        c = _static_moment_coefficients(beam, 0.5, True)
-        return L**2 * np.where(xi >= 0.5, np.polynomial.polynomial.polyval(xi, c[1]),
-                               np.polynomial.polynomial.polyval(xi, c[0]))
-    alpha = position / L
-    c = _static_moment_coefficients(beam, alpha, False)
-    return L * np.where(xi >= alpha, np.polynomial.polynomial.polyval(xi, c[1]), np.polynomial.polynomial.polyval(xi, c[0]))
-
-
 def _excitation_static(beam: Any, excitation: Any, x: np.ndarray) -> np.ndarray:
-    """Static moment at ``x`` per unit of the excitation's time history ``u``."""
+    """Static moment at ``x`` per unit of the excitation's time history ``u``.
+
+    A point force acts at its position; a distributed force is uniform; a
+    base acceleration loads the beam with ``-rho A(x) u`` and each point mass
+    with ``-m u`` (the loads whose modal weights the solver uses).
+    """
     if excitation.kind == "none":
         return np.zeros(x.size)
     if excitation.kind == "point_force":
-        return _static_moment(beam, x, float(excitation.position))
-    per_length = -beam.mass_per_length if excitation.kind == "base_acceleration" else 1.0
-    return per_length * _static_moment(beam, x, None)
+        return static_moment(beam, x, [(float(excitation.position), 1.0)])
+    pieces = beam.pieces()
+    if excitation.kind == "base_acceleration":
+        return static_moment(beam, x, [(m.position, -m.mass) for m in beam.masses],
+                             [-p.mass_per_length for p in pieces])
+    return static_moment(beam, x, (), [1.0] * len(pieces))
 
 
 def _free_coordinates(sol: Any, eta: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -131,10 +115,10 @@ def bending_moment(
     rows = _moment_rows(free.modes, x, beam.bending_stiffness)  # (n, nx)
     M = eta @ rows
     if static_correction:
-        if not beam.is_uniform or free.modes.n_rigid:
+        if free.modes.n_rigid:
             emit_user_level_warning(
-                "bending moment: no static correction for a stepped beam, one carrying masses or springs, or one "
-                "that can move as a rigid body; the plain modal sum converges slowly near loads and stops"
+                "bending moment: no static correction for a beam that can move as a rigid body (no static "
+                "solution); the plain modal sum converges slowly near loads and stops"
             )
         else:
             M += _static_part(result, space, free, x, t, smp, rows)
@@ -153,7 +137,7 @@ def _static_part(result: Any, space: Any, free: Any, x: np.ndarray, t: np.ndarra
         compression = c.direction * smp.w[:, i] - c.gap
         f = np.where(smp.engaged[:, i], -c.direction * c.stiffness * compression, 0.0)  # force on the beam, along +w
         Q += f[:, None] * free.W_contact[i][None, :]
-        out += f[:, None] * _static_moment(beam, x, c.position)[None, :]
+        out += f[:, None] * static_moment(beam, x, [(c.position, 1.0)])[None, :]
     lam = free.modes.omega ** 2
     return out - (Q / lam[None, :]) @ rows
 
@@ -239,8 +223,9 @@ def max_bending_stress(result: ResultLike, *, points: int = 201) -> tuple[float,
             bt = _golden(lambda s: _abs_stress(result, bx, s), max(bt - dt, 0.0), min(bt + dt, t_end), 1e-10 * dt)
             bx = _golden(lambda y: _abs_stress(result, y, bt), max(bx - step_x, 0.0), min(bx + step_x, L), 1e-9 * L)
         best = max(best, _abs_stress(result, bx, bt))
-    if not (beam.is_uniform and not sol.packed.space.state(()).modes.n_rigid):
-        emit_user_level_warning("max_bending_stress: from the plain modal sum (no static correction for this beam)")
+    if sol.packed.space.state(()).modes.n_rigid:
+        emit_user_level_warning("max_bending_stress: from the plain modal sum (no static correction for a beam "
+                                "that can move as a rigid body)")
     return best, bt, bx
 
 
