@@ -63,7 +63,7 @@ MEANING: dict[str, str] = {
     "solver.event_tolerance": "Tolerance of the event-time root finder [s].",
     "solver.projection": "How the modal state is carried across an event: `paper` (default, the L2 projection of eq. 12) or `contact`.",
     "solver.tolerance": "Relative change of the Table-2 metrics that counts as converged in the modes (default 2e-3); with `modes = \"auto\"` the stopping rule, otherwise the threshold of the unconverged warning.",
-    "solver.basis": "`enriched` (default): one shared basis, the free modes plus a static attachment shape per contactor, exact switches; `paper`: each state's own modes joined by the projection of eq. 12.",
+    "solver.basis": "`enriched` (default): one shared basis, the free modes plus a static attachment shape per contactor (and the engaged state's modes for a stop much stiffer than the beam), exact switches; `paper`: each state's own modes joined by the projection of eq. 12.",
     "beam.sections[].length": "Length of this uniform piece [m]; the pieces, in order from x = 0, sum to `beam.length`.",
     "beam.sections[].width": "Width of this piece [m] (default the `[beam]` value).",
     "beam.sections[].height": "Height of this piece [m] (default the `[beam]` value).",

@@ -34,7 +34,7 @@ from ._exact import layout
 from .exceptions import ParameterError
 from .model.beam import Beam
 
-__all__ = ["static_moment"]
+__all__ = ["static_moment", "static_state"]
 
 
 def _element(h: float, EI: float, flex: float, q: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -63,8 +63,8 @@ def _element(h: float, EI: float, flex: float, q: float) -> tuple[np.ndarray, np
 
 @functools.lru_cache(maxsize=256)
 def _solve(beam: Beam, forces: tuple[tuple[float, float], ...], per_length: tuple[float, ...],
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Nodes, per-piece ``(M0, V0)``, piece loads and piece starts of one static load case."""
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Piece starts and per-piece ``(W0, Psi0, M0, V0, q, EI, 1/kGA)`` of one static load case."""
     lay = layout(beam, [(x, 0.0) for x, _ in forces])
     nodes = np.unique(np.concatenate([lay.nodes, [x for x, _ in forces]]))
     pieces = beam.pieces()
@@ -82,7 +82,7 @@ def _solve(beam: Beam, forces: tuple[tuple[float, float], ...], per_length: tupl
         sl = slice(2 * j, 2 * j + 4)
         K[sl, sl] += Ke
         f[sl] -= fe
-        mats.append((G, per_length[i]))
+        mats.append((G, per_length[i], p.bending_stiffness, flex))
     for x, F in forces:
         f[2 * int(np.argmin(np.abs(nodes - x)))] += F
     free = np.ones(2 * n, dtype=bool)
@@ -99,9 +99,36 @@ def _solve(beam: Beam, forces: tuple[tuple[float, float], ...], per_length: tupl
         if np.linalg.cond(Kf) > 1e13:
             raise ParameterError("static response: the supports let the beam move as a rigid body")
         d[free] = np.linalg.solve(Kf, f[free])
-    MV = np.array([G @ np.append(d[2 * j: 2 * j + 4], 1.0) for j, (G, _) in enumerate(mats)])
-    q = np.array([qq for _, qq in mats])
-    return nodes, MV, q, nodes[:-1]
+    rows = [(*d[2 * j: 2 * j + 2], *(G @ np.append(d[2 * j: 2 * j + 4], 1.0)), q, EI, flex)
+            for j, (G, q, EI, flex) in enumerate(mats)]
+    return nodes, np.array(rows)
+
+
+def static_state(beam: Beam, x: Sequence[float] | np.ndarray, forces: Sequence[tuple[float, float]] = (),
+                 per_length: Sequence[float] | None = None) -> tuple[np.ndarray, ...]:
+    """Static deflection and its derivatives at ``x`` under point forces and a distributed load.
+
+    Returns ``(W, Psi, M, V, W1, W2, W3)``: deflection [m], cross-section
+    rotation (``W'`` for Euler-Bernoulli), moment ``M = EI Psi'`` [N m], shear
+    ``V = -M'`` [N], and the first three x-derivatives of ``W`` (from
+    ``W' = Psi + V / kappa G A``). Parameters as :func:`static_moment`; at a
+    node, the values to the right.
+    """
+    pieces = beam.pieces()
+    q = tuple(float(v) for v in (per_length if per_length is not None else [0.0] * len(pieces)))
+    if len(q) != len(pieces):
+        raise ParameterError(f"per_length: one value per section ({len(pieces)}), got {len(q)}")
+    key = tuple(sorted((float(a), float(F)) for a, F in forces))
+    nodes, rows = _solve(beam, key, q)
+    x = np.atleast_1d(np.asarray(x, dtype=float))
+    j = np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2)
+    u = x - nodes[j]
+    W0, P0, M0, V0, qq, EI, flex = rows[j].T
+    V = V0 - qq * u
+    M = M0 - V0 * u + qq * u * u / 2.0
+    Psi = P0 + (M0 * u - V0 * u * u / 2.0 + qq * u**3 / 6.0) / EI
+    W = W0 + P0 * u + (M0 * u * u / 2.0 - V0 * u**3 / 6.0 + qq * u**4 / 24.0) / EI + flex * (V0 * u - qq * u * u / 2.0)
+    return W, Psi, M, V, Psi + flex * V, M / EI - flex * qq, -V / EI
 
 
 def static_moment(beam: Beam, x: Sequence[float] | np.ndarray, forces: Sequence[tuple[float, float]] = (),
@@ -124,13 +151,4 @@ def static_moment(beam: Beam, x: Sequence[float] | np.ndarray, forces: Sequence[
     ParameterError
         If the supports allow rigid-body motion.
     """
-    pieces = beam.pieces()
-    q = tuple(float(v) for v in (per_length if per_length is not None else [0.0] * len(pieces)))
-    if len(q) != len(pieces):
-        raise ParameterError(f"per_length: one value per section ({len(pieces)}), got {len(q)}")
-    key = tuple(sorted((float(a), float(F)) for a, F in forces))
-    nodes, MV, qq, starts = _solve(beam, key, q)
-    x = np.atleast_1d(np.asarray(x, dtype=float))
-    j = np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2)
-    u = x - starts[j]
-    return MV[j, 0] - MV[j, 1] * u + qq[j] * u * u / 2.0
+    return static_state(beam, x, forces, per_length)[2]

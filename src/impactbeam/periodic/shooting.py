@@ -346,9 +346,9 @@ def periodic_orbit(
     else:
         res, end, n_modes = _settle(scenario, M, settle_periods)
         sol = res.solution
-        from ..solver.ritz import RitzStateSpace
+        from ..solver.ritz_space import RitzStateSpace
 
-        # per-state modes (solver.basis = "paper", or a beam the shared basis does not cover yet)
+        # per-state modes (solver.basis = "paper", or a beam that can move as a rigid body)
         prefer_free = not isinstance(sol.packed.space, RitzStateSpace)
         phase = _section_phase(sol, end - M / f, end, float(exc.start), f, prefer_free)
         pmap = StroboscopicMap(scenario, M, phase, n_modes)

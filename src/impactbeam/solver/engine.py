@@ -66,21 +66,24 @@ def initial_coordinates(beam: Beam, initial: InitialCondition, n_modes: int) -> 
 def make_space(beam, contactors, damping, excitation, options: SolverOptions, points) -> StateSpace:
     """The state space of ``options.basis``: the paper's per-state modes or the shared Ritz basis.
 
-    The shared basis needs the static shapes of a uniform beam with end
-    springs; a beam with sections, point masses or interior springs uses the
-    paper's per-state modes (a warning says so).
+    The shared basis needs a static attachment shape per contactor: the
+    polynomials of the paper's uniform beam (inertia relief when it can move
+    as a rigid body), or the exact static solver for any other beam its
+    supports hold. A stepped beam, one with masses or springs, or a
+    Timoshenko beam that can move as a rigid body uses the paper's per-state
+    modes (a warning says so).
     """
-    if options.basis == "enriched" and beam.is_uniform:
-        from .ritz import RitzStateSpace
+    if options.basis == "enriched" and (beam.is_uniform or not mode_set(beam, (), options.modes).n_rigid):
+        from .ritz_space import RitzStateSpace
 
         return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points)  # type: ignore[return-value]
     if options.basis == "enriched" and contactors:
         from .._warnings import emit_user_level_warning
 
         emit_user_level_warning(
-            'solver.basis: the enriched basis does not support [[beam.sections]], [[masses]], [[springs]] or '
-            'a Timoshenko beam yet; using the paper\'s per-state modes (solver.basis = "paper"), which need more modes for stiff '
-            "contactors"
+            "solver.basis: the enriched basis needs a static attachment shape, and this beam (stepped, with "
+            "masses or springs, or Timoshenko) can move as a rigid body; using the paper's per-state modes "
+            '(solver.basis = "paper"), which need more modes for stiff contactors'
         )
     return StateSpace(beam, contactors, damping, excitation, options.modes, points)
 

@@ -50,6 +50,13 @@ then **inertia relief** is used: the unit force is balanced by the d'Alembert
 load of the rigid-body modes, ``EI g'''' = delta_a - rho A sum_r phi_r(x)
 phi_r(a)`` (a piecewise quintic), and the rigid-body part of ``g`` is removed.
 
+Any other beam of the model its supports hold (sections, point masses,
+interior springs, Timoshenko) gets its static shape from the exact static
+solver (:mod:`impactbeam._static`), and every inner product of the basis is
+the kinetic one of that beam: ``rho A(x)`` on the quadrature, ``rho I(x)`` on
+the rotations of a Timoshenko beam, ``m`` and ``J`` at the point masses. Such
+a beam that can move as a rigid body keeps the paper's basis.
+
 Damping: each mode of a state gets that state's ratio (``damping.free`` or
 ``damping.contact``, per mode when a list), as the paper does per mode.
 
@@ -73,15 +80,12 @@ from collections.abc import Sequence
 import numpy as np
 import scipy.linalg
 
-from ..model.beam import Beam, Contactor
-from ..exceptions import ParameterError
-from ..model.loading import Excitation, InitialCondition, spatial_projection
+from ..model.beam import Beam
 from ..modal import ModeSet, mode_set
-from ..model import Damping
-from .states import ModalDynamics, StateModel
+from .._static import static_state
 from .statics import static_coefficients
 
-__all__ = ["RitzBasis", "RitzModes", "RitzStateSpace", "ritz_basis"]
+__all__ = ["RitzBasis", "ritz_basis"]
 
 _MERGE = 3e-5  # contactors closer than this fraction of L share one attachment shape
 _DROP = 1e-11  # a residual shape smaller than this fraction of its static shape is dropped
@@ -92,6 +96,17 @@ _GX, _GW = np.polynomial.legendre.leggauss(20)
 
 
 # --------------------------------------------------------------------------- the basis
+
+
+
+
+def _mode_field(ms: ModeSet, x: np.ndarray, field: int | str) -> np.ndarray:
+    """A field of a mode set at ``x``: (n, p)."""
+    if field == "rot":
+        return ms.rotations(x)
+    if field == "moment":
+        return ms.moment_shapes(x)
+    return ms.shapes(x, int(field))
 
 
 class RitzBasis:
@@ -143,20 +158,50 @@ class RitzBasis:
         self.count = int(self.lam.size)
         self.integral = (self.values(self._x) @ self._w)
         self.integral.setflags(write=False)
+        self.inertia = self._sample(self.values, rows="translation").T @ self._sample_weights()
+        self.inertia.setflags(write=False)
+
+    def _sample_weights(self) -> np.ndarray:
+        """``sqrt`` of the translational kinetic weights of :meth:`_sample` (quadrature and point masses)."""
+        lay = self.free._layout
+        at = lay.m > 0.0
+        return np.concatenate([np.sqrt(self.beam.mass_per_length_at(self._x) * self._w), np.sqrt(lay.m[at])])
+
+    def _sample(self, fn, rows: str = "all") -> np.ndarray:
+        """Functions ``fn(x, field)`` weighted so that ``S^T S`` is their kinetic inner product: (rows, n).
+
+        Rows: the quadrature with ``rho A(x) w``, the point masses with ``m``;
+        then (``rows="all"``) the rotations, with ``rho I(x) w`` for a
+        Timoshenko beam and ``J`` at the point masses.
+        """
+        lay = self.free._layout
+        at, atJ = lay.m > 0.0, lay.J > 0.0
+        parts = [(fn(self._x, 0) * np.sqrt(self.beam.mass_per_length_at(self._x) * self._w)).T]
+        if at.any():
+            parts.append((fn(lay.nodes[at], 0) * np.sqrt(lay.m[at])).T)
+        if rows == "all":
+            if self.beam.is_timoshenko:
+                parts.append((fn(self._x, "rot") * np.sqrt(self.beam.rotary_inertia_at(self._x) * self._w)).T)
+            if atJ.any():
+                parts.append((fn(lay.nodes[atJ], "rot") * np.sqrt(lay.J[atJ])).T)
+        return np.concatenate(parts)
+
+    def _free_at(self, x: np.ndarray, field: int | str) -> np.ndarray:
+        return _mode_field(self.free, x, field)
 
     def _keep_attachments(self) -> None:
         """Second Gram-Schmidt pass on the attachment shapes; drop those the retained modes already hold."""
-        rhoA, L = self.beam.mass_per_length, self.beam.length
-        Rq = self._residuals_at(self._x, 0)  # (n_c, q)
-        if self._alpha.size and self.free.count > self.free.n_rigid:
+        L = self.beam.length
+        r = self.free.n_rigid
+        Rq = self._sample(self._residuals_at)  # (rows, n_c)
+        if self._alpha.size and self.free.count > r:
             # r_c is a small difference of O(1) shapes (~N^-3.5 of g_c), so remove
             # what round-off left along the retained modes
-            Fq = self.free.shapes(self._x)[self.free.n_rigid :]
-            self.__dict__["_modal_static"] = self._modal_static + rhoA * (Fq * self._w) @ Rq.T
-            Rq = self._residuals_at(self._x, 0)
-        gq = self._static_at(self._x, 0)
-        g_norm = np.sqrt(rhoA * (gq**2) @ self._w)
-        r_norm = np.sqrt(rhoA * (Rq**2) @ self._w)
+            Fq = self._sample(self._free_at)[:, r:]
+            self.__dict__["_modal_static"] = self._modal_static + Fq.T @ Rq
+            Rq = self._sample(self._residuals_at)
+        g_norm = np.linalg.norm(self._sample(self._static_at), axis=0)
+        r_norm = np.linalg.norm(Rq, axis=0)
         keep = r_norm > _DROP * g_norm
         lossy = keep & (r_norm < _LOSSY * g_norm)
         if lossy.any():
@@ -187,14 +232,14 @@ class RitzBasis:
         scale = max(float(exact.max(initial=0.0)), 1e-300)
         return bool(np.max(np.abs(ritz - exact[: ritz.size]) / np.maximum(exact[: ritz.size], 1e-9 * scale)) > _UNION)
 
-    def _extra_at(self, x: np.ndarray, derivative: int) -> np.ndarray:
+    def _extra_at(self, x: np.ndarray, derivative: int | str) -> np.ndarray:
         """The residual functions before orthonormalisation: attachment shapes, then ``psi_j - sum_i P_ij phi_i``."""
         R = self._residuals_at(x, derivative)
         if self._contact is not None:
-            F = self.free.shapes(x, derivative)
-            R = np.concatenate([R, self._contact.shapes(x, derivative) - self._P.T @ F])
+            F = self._free_at(x, derivative)
+            R = np.concatenate([R, _mode_field(self._contact, x, derivative) - self._P.T @ F])
         if self._C.shape[1]:
-            R = R - self._C.T @ self.free.shapes(x, derivative)
+            R = R - self._C.T @ self._free_at(x, derivative)
         return R
 
     def _extra_stiffness(self, contact: Sequence[tuple[float, float]]) -> np.ndarray:
@@ -228,9 +273,8 @@ class RitzBasis:
         contact-state mode the free modes already hold) is dropped, so no
         combination amplifies round-off by more than ``1 / _NEW``.
         """
-        sw = np.sqrt(self.beam.mass_per_length * self._w)
-        F = (self.free.shapes(self._x) * sw).T  # (q, N), orthonormal columns
-        B = (self._extra_at(self._x, 0) * sw).T
+        F = self._sample(self._free_at)  # (rows, N), orthonormal columns
+        B = self._sample(self._extra_at)
         C = np.zeros((F.shape[1], B.shape[1]))
         for _ in range(2):
             c = F.T @ B
@@ -259,10 +303,10 @@ class RitzBasis:
         The wavelengths are those of the free modes and of the ``engaged`` state's modes.
         """
         L = self.beam.length
-        bmax = max(float(self.free.beta.max(initial=0.0)), 4.0 / L)
+        bmax = max(float(self.free._beta_max), 4.0 / L)
         if engaged is not None:
-            bmax = max(bmax, float(engaged.beta.max(initial=0.0)))
-        breaks = np.unique(np.concatenate([[0.0, L], self._alpha * L]))
+            bmax = max(bmax, float(engaged._beta_max))
+        breaks = np.unique(np.concatenate([[0.0, L], self._alpha * L, self.free.nodes]))
         xs, ws = [], []
         for a, b in zip(breaks[:-1], breaks[1:]):
             n = max(1, math.ceil((b - a) * bmax / math.pi))
@@ -293,9 +337,22 @@ class RitzBasis:
             out.append(static_coefficients(beam, float(al), q0, q1))
         return out
 
-    def _static_at(self, x: np.ndarray, derivative: int) -> np.ndarray:
-        """Static shapes ``g_c`` [m/N] (or x-derivatives) at ``x``, rigid-body part removed: (n_c, p)."""
+    def _static_at(self, x: np.ndarray, derivative: int | str) -> np.ndarray:
+        """Static shapes ``g_c`` [m/N] (or a field) at ``x``, rigid-body part removed: (n_c, p).
+
+        The paper's uniform beam: the polynomials (inertia relief with
+        rigid-body modes); any other beam its supports hold: the exact static
+        solver (:func:`impactbeam._static.static_state`).
+        """
         beam, L = self.beam, self.beam.length
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        if not beam.is_uniform:
+            index = {0: 0, 1: 4, 2: 5, 3: 6, "rot": 1, "moment": 2}[derivative]
+            return np.array([static_state(beam, x, [(float(a * L), 1.0)])[index] for a in self._alpha]).reshape(-1, x.size)
+        if derivative == "moment":
+            return beam.bending_stiffness * self._static_at(x, 2)
+        if derivative == "rot":
+            derivative = 1
         xi = x / L
         scale = L**3 / beam.bending_stiffness / L**derivative
         out = np.empty((self._alpha.size, x.size))
@@ -338,17 +395,22 @@ class RitzBasis:
         r = ms.n_rigid
         return ms.shapes(self._alpha * self.beam.length)[r:] / (ms.omega[r:] ** 2)[:, None]
 
-    def _residuals_at(self, x: np.ndarray, derivative: int) -> np.ndarray:
-        """Residual shapes ``r_c = g_c - sum_i phi_i phi_i(a_c) / omega_i^2`` (or derivatives) at ``x``: (n_c, p)."""
+    def _residuals_at(self, x: np.ndarray, derivative: int | str) -> np.ndarray:
+        """Residual shapes ``r_c = g_c - sum_i phi_i phi_i(a_c) / omega_i^2`` (or a field) at ``x``: (n_c, p)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         g = self._static_at(x, derivative)
         r = self.free.n_rigid
-        return g - self._modal_static.T @ self.free.shapes(x, derivative)[r:]
+        return g - self._modal_static.T @ self._free_at(x, derivative)[r:]
 
-    def values(self, x: float | Sequence[float] | np.ndarray, derivative: int = 0) -> np.ndarray:
-        """The ``N + n_r`` basis functions (or x-derivatives, 0..3) at ``x``: shape (n, p)."""
+    def values(self, x: float | Sequence[float] | np.ndarray, derivative: int | str = 0) -> np.ndarray:
+        """The ``N + n_r`` basis functions at ``x``: shape (n, p).
+
+        ``derivative``: 0..3 for ``d^k W / dx^k``, ``"rot"`` for the
+        cross-section rotation, ``"moment"`` for the bending moment per unit
+        coordinate (``EI W''``, or ``EI Psi'`` for a Timoshenko beam).
+        """
         x = np.atleast_1d(np.asarray(x, dtype=float))
-        out = self.free.shapes(x, derivative)
+        out = self._free_at(x, derivative)
         if self._Z.size:
             out = np.concatenate([out, self._Z.T @ self._extra_at(x, derivative)])
         return out
@@ -366,185 +428,3 @@ def ritz_basis(beam: Beam, positions: Sequence[float], n_modes: int,
     ``contact``, the engaged springs as (position, stiffness)) that contact state's modes (cached)."""
     key = tuple(sorted((float(x), float(k)) for x, k in contact))
     return _cached_basis(beam, tuple(sorted(float(p) for p in positions)), int(n_modes), key)
-
-
-# --------------------------------------------------------------------------- state modes
-
-
-class RitzModes:
-    """Modes of one state in the shared basis: ``W_m(x) = sum_j Phi[j, m] psi_j(x)``.
-
-    Offers the part of :class:`~impactbeam.modal.ModeSet`'s interface the
-    solver and the results use (``omega``, ``count``, ``frequencies_hz``,
-    ``shapes``, ``integral``). They are mass-orthonormal
-    (``rho A int W_n W_m dx = delta_nm``) and there are ``N + n_r`` of them:
-    the approximation of the state's lowest ``N + n_r`` modes (Rayleigh-Ritz).
-    """
-
-    def __init__(self, basis: RitzBasis, Phi: np.ndarray, omega: np.ndarray) -> None:
-        self.basis = basis
-        self.Phi = Phi
-        self.omega = omega
-        self.beam = basis.beam
-
-    @property
-    def count(self) -> int:
-        """Number of modes, ``N + n_r``."""
-        return int(self.omega.size)
-
-    @property
-    def n_rigid(self) -> int:
-        """Number of zero-frequency modes."""
-        return int(np.sum(self.omega == 0.0))
-
-    @property
-    def frequencies_hz(self) -> np.ndarray:
-        """Natural frequencies [Hz]."""
-        return self.omega / (2.0 * np.pi)
-
-    def shapes(self, x: float | Sequence[float] | np.ndarray, derivative: int = 0) -> np.ndarray:
-        """Mode shapes (or x-derivatives 0..3) at ``x``: shape (n, p), like :meth:`ModeSet.shapes`."""
-        if derivative not in (0, 1, 2, 3):
-            raise ParameterError(f"derivative: must be 0, 1, 2 or 3, got {derivative!r}")
-        return self.Phi.T @ self.basis.values(x, derivative)
-
-    def __call__(self, x: float | Sequence[float] | np.ndarray) -> np.ndarray:
-        return self.shapes(x)
-
-    def integral(self) -> np.ndarray:
-        """``int_0^L W_n dx`` [m kg^-0.5], shape (n,)."""
-        return self.Phi.T @ self.basis.integral
-
-
-def _state_eigen(basis: RitzBasis, springs: Sequence[tuple[int, float]], at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(omega, Phi)`` of ``diag(lam) + sum k b b^T`` (mass matrix the identity).
-
-    ``at[:, j]`` is ``psi(a_j)``; ``springs`` are (column, stiffness). Without
-    springs the free-state stiffness is already diagonal and ``Phi`` is the
-    identity (so the basis reduces exactly to the free modes).
-    """
-    n = basis.count
-    if not springs:
-        order = np.argsort(basis.lam, kind="stable")
-        Phi = np.eye(n)[:, order]
-        return np.sqrt(np.maximum(basis.lam[order], 0.0)), Phi
-    K = np.diag(basis.lam)
-    for j, k in springs:
-        K += k * np.outer(at[:, j], at[:, j])
-    lam, Phi = np.linalg.eigh(0.5 * (K + K.T))
-    lam = np.where(lam < 1e-13 * abs(lam).max(), 0.0, lam)
-    # deterministic sign: largest component positive
-    idx = np.argmax(np.abs(Phi), axis=0)
-    Phi = Phi * np.sign(Phi[idx, np.arange(n)])
-    return np.sqrt(lam), Phi
-
-
-# --------------------------------------------------------------------------- the state space
-
-
-class RitzStateSpace:
-    """Drop-in for :class:`~impactbeam.solver.states.StateSpace` on the shared Ritz basis.
-
-    Every state has ``N + n_r`` modes (``N = n_modes`` retained free modes,
-    ``n_r`` residual functions, normally one per contactor position);
-    :attr:`count` gives it. ``transfer`` is the exact change of
-    coordinates between two states (orthogonal), not the projection of eq. (12).
-    """
-
-    def __init__(
-        self,
-        beam: Beam,
-        contactors: Sequence[Contactor],
-        damping: Damping,
-        excitation: Excitation,
-        n_modes: int,
-        points: np.ndarray,
-    ) -> None:
-        self.beam = beam
-        self.contactors = tuple(contactors)
-        self.damping = damping
-        self.excitation = excitation
-        self.n_modes = n_modes
-        self.points = np.asarray(points, dtype=float).reshape(-1)
-        self.positions = np.array([c.position for c in self.contactors], dtype=float)
-        for i, c in enumerate(self.contactors):
-            if not math.isfinite(c.stiffness):
-                raise ParameterError(
-                    f"contactors.{i}.stiffness: a rigid stop cannot be integrated in the enriched basis "
-                    "(solver.basis); give a finite stiffness"
-                )
-        self.basis = ritz_basis(beam, self.positions, n_modes, [(c.position, c.stiffness) for c in self.contactors])
-        self._psi_c = self.basis.values(self.positions) if self.contactors else np.zeros((self.basis.count, 0))
-        self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
-        self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length)
-        self._states: dict[tuple[int, ...], StateModel] = {}
-        self._T: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
-
-    @property
-    def count(self) -> int:
-        """Modes per state, ``N + n_r``."""
-        return self.basis.count
-
-    def state(self, engaged: tuple[int, ...]) -> StateModel:
-        """The state with the contactors ``engaged`` (cached)."""
-        st = self._states.get(engaged)
-        if st is None:
-            springs = [(i, self.contactors[i].stiffness) for i in engaged]
-            omega, Phi = _state_eigen(self.basis, springs, self._psi_c)
-            ms = RitzModes(self.basis, Phi, omega)
-            n = ms.count
-            dyn = ModalDynamics(omega, self.damping.ratios(bool(engaged), n))
-            Wc = np.ascontiguousarray((Phi.T @ self._psi_c).T) if self.contactors else np.zeros((0, n))
-            Wo = np.ascontiguousarray((Phi.T @ self._psi_o).T) if self.points.size else np.zeros((0, n))
-            p = Phi.T @ self._p
-            st = StateModel(engaged, ms, dyn, Wc, Wo, p)  # type: ignore[arg-type]
-            self._states[engaged] = st
-        return st
-
-    def projection(self, to: tuple[int, ...], frm: tuple[int, ...]) -> np.ndarray:
-        """The exact change of coordinates ``Phi_to^T Phi_from`` (replaces eq. 12)."""
-        key = (to, frm)
-        T = self._T.get(key)
-        if T is None:
-            T = self.state(to).modes.Phi.T @ self.state(frm).modes.Phi  # type: ignore[attr-defined]
-            self._T[key] = T
-        return T
-
-    def transfer(self, to: tuple[int, ...], frm: tuple[int, ...], preserve_contacts: bool = False) -> np.ndarray:
-        """``T`` with ``eta_to = T @ eta_from``; exact, so ``preserve_contacts`` changes nothing."""
-        return self.projection(to, frm)
-
-    @property
-    def states(self) -> dict[tuple[int, ...], StateModel]:
-        return self._states
-
-    def initial_coordinates(self, initial: InitialCondition) -> tuple[np.ndarray, np.ndarray]:
-        """Free-state modal displacement and velocity at t = 0 in this basis.
-
-        ``initial.tip_displacement``: the static equilibrium of the reduced
-        model under a point force at ``initial.position`` (default the tip),
-        scaled so that the reduced model's deflection there is exactly the
-        given one. ``modal_displacement`` / ``modal_velocity`` apply to the
-        retained free modes (the first ``N`` coordinates of the free state).
-        """
-        st = self.state(())
-        n = st.modes.count
-        eta, deta = np.zeros(n), np.zeros(n)
-        if initial.tip_displacement:
-            ms: RitzModes = st.modes  # type: ignore[assignment]
-            if ms.n_rigid:
-                raise ParameterError(
-                    "initial.tip_displacement: the supports allow rigid-body motion, so a static load shape does not exist"
-                )
-            x0 = self.beam.length if initial.position is None else initial.position
-            w0 = ms.shapes([x0])[:, 0]
-            q = w0 / ms.omega**2
-            eta = q * (initial.tip_displacement / float(w0 @ q))
-        # the free state's first N modes are the retained free modes, in order
-        N = self.basis.free.count
-        for src, dst in ((initial.modal_displacement, eta), (initial.modal_velocity, deta)):
-            if src is not None:
-                v = np.asarray(src, dtype=float)
-                m = min(v.size, N)
-                dst[:m] += v[:m]
-        return eta, deta
