@@ -24,7 +24,7 @@ from ..model import Damping
 from ..model.beam import Beam, Contactor
 from ..model.loading import Excitation, InitialCondition, spatial_projection
 from .ritz import RitzBasis, ritz_basis
-from .states import ModalDynamics, StateModel
+from .states import ModalDynamics, ProblemSpace, StateModel
 
 __all__ = ["RitzModes", "RitzStateSpace"]
 
@@ -127,7 +127,7 @@ def _state_eigen(basis: RitzBasis, springs: Sequence[tuple[int, float]], at: np.
 # --------------------------------------------------------------------------- the state space
 
 
-class RitzStateSpace:
+class RitzStateSpace(ProblemSpace):
     """Drop-in for :class:`~impactbeam.solver.states.StateSpace` on the shared Ritz basis.
 
     Every state has ``N + n_r`` modes (``N = n_modes`` retained free modes,
@@ -145,13 +145,7 @@ class RitzStateSpace:
         n_modes: int,
         points: np.ndarray,
     ) -> None:
-        self.beam = beam
-        self.contactors = tuple(contactors)
-        self.damping = damping
-        self.excitation = excitation
-        self.n_modes = n_modes
-        self.points = np.asarray(points, dtype=float).reshape(-1)
-        self.positions = np.array([c.position for c in self.contactors], dtype=float)
+        super().__init__(beam, contactors, damping, excitation, n_modes, points)
         for i, c in enumerate(self.contactors):
             if not math.isfinite(c.stiffness):
                 raise ParameterError(
@@ -163,7 +157,6 @@ class RitzStateSpace:
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
         self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length,
                                      self.basis.inertia)
-        self._states: dict[tuple[int, ...], StateModel] = {}
         self._T: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
 
     @property
@@ -199,10 +192,6 @@ class RitzStateSpace:
     def transfer(self, to: tuple[int, ...], frm: tuple[int, ...], preserve_contacts: bool = False) -> np.ndarray:
         """``T`` with ``eta_to = T @ eta_from``; exact, so ``preserve_contacts`` changes nothing."""
         return self.projection(to, frm)
-
-    @property
-    def states(self) -> dict[tuple[int, ...], StateModel]:
-        return self._states
 
     def initial_coordinates(self, initial: InitialCondition) -> tuple[np.ndarray, np.ndarray]:
         """Free-state modal displacement and velocity at t = 0 in this basis.

@@ -93,8 +93,20 @@ class StateModel:
         return float(self.modes.omega.max())
 
 
-class StateSpace:
-    """Builds and caches the states of one problem and the projections between them."""
+class ProblemSpace:
+    """What every state space of one problem holds: the system, the output points, the built states.
+
+    Parameters
+    ----------
+    beam : Beam
+    contactors : sequence of Contactor
+    damping : Damping
+    excitation : Excitation
+    n_modes : int
+        Retained modes per state (the paper's N).
+    points : ndarray, [m]
+        Output positions.
+    """
 
     def __init__(
         self,
@@ -110,10 +122,30 @@ class StateSpace:
         self.damping = damping
         self.excitation = excitation
         self.n_modes = n_modes
-        self.points = np.asarray(points, dtype=float)
-        self._states: dict[tuple[int, ...], StateModel] = {}
-        self._proj: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
+        self.points = np.asarray(points, dtype=float).reshape(-1)
         self.positions = np.array([c.position for c in self.contactors], dtype=float)
+        self._states: dict[tuple[int, ...], StateModel] = {}
+
+    @property
+    def states(self) -> dict[tuple[int, ...], StateModel]:
+        """The states built so far, by their engaged contactors."""
+        return self._states
+
+
+class StateSpace(ProblemSpace):
+    """Builds and caches the states of one problem (the paper's per-state modes) and the projections between them."""
+
+    def __init__(
+        self,
+        beam: Beam,
+        contactors: Sequence[Contactor],
+        damping: Damping,
+        excitation: Excitation,
+        n_modes: int,
+        points: np.ndarray,
+    ) -> None:
+        super().__init__(beam, contactors, damping, excitation, n_modes, points)
+        self._proj: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
 
     def state(self, engaged: tuple[int, ...]) -> StateModel:
         st = self._states.get(engaged)
@@ -173,7 +205,3 @@ class StateSpace:
                 T = P
             self._proj[key] = T  # type: ignore[index]
         return T
-
-    @property
-    def states(self) -> dict[tuple[int, ...], StateModel]:
-        return self._states
