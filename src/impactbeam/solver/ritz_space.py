@@ -157,7 +157,6 @@ class RitzStateSpace(ProblemSpace):
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
         self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length,
                                      self.basis.inertia)
-        self._T: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
 
     @property
     def count(self) -> int:
@@ -183,10 +182,10 @@ class RitzStateSpace(ProblemSpace):
     def projection(self, to: tuple[int, ...], frm: tuple[int, ...]) -> np.ndarray:
         """The exact change of coordinates ``Phi_to^T Phi_from`` (replaces eq. 12)."""
         key = (to, frm)
-        T = self._T.get(key)
+        T = self._proj.get(key)
         if T is None:
             T = self.state(to).modes.Phi.T @ self.state(frm).modes.Phi  # type: ignore[attr-defined]
-            self._T[key] = T
+            self._proj[key] = T
         return T
 
     def transfer(self, to: tuple[int, ...], frm: tuple[int, ...], preserve_contacts: bool = False) -> np.ndarray:

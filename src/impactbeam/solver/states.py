@@ -125,6 +125,7 @@ class ProblemSpace:
         self.points = np.asarray(points, dtype=float).reshape(-1)
         self.positions = np.array([c.position for c in self.contactors], dtype=float)
         self._states: dict[tuple[int, ...], StateModel] = {}
+        self._proj: dict[tuple, np.ndarray] = {}  # projections / changes of coordinates between states
 
     @property
     def states(self) -> dict[tuple[int, ...], StateModel]:
@@ -134,18 +135,6 @@ class ProblemSpace:
 
 class StateSpace(ProblemSpace):
     """Builds and caches the states of one problem (the paper's per-state modes) and the projections between them."""
-
-    def __init__(
-        self,
-        beam: Beam,
-        contactors: Sequence[Contactor],
-        damping: Damping,
-        excitation: Excitation,
-        n_modes: int,
-        points: np.ndarray,
-    ) -> None:
-        super().__init__(beam, contactors, damping, excitation, n_modes, points)
-        self._proj: dict[tuple[tuple[int, ...], tuple[int, ...]], np.ndarray] = {}
 
     def state(self, engaged: tuple[int, ...]) -> StateModel:
         st = self._states.get(engaged)
@@ -194,7 +183,7 @@ class StateSpace(ProblemSpace):
         ``T = P + C^T (C C^T)^+ (D - C P)`` with ``C = W_to(a)``, ``D = W_from(a)``.
         """
         key = (to, frm, preserve_contacts)
-        T = self._proj.get(key)  # type: ignore[arg-type]
+        T = self._proj.get(key)
         if T is None:
             P = self.projection(to, frm)
             if preserve_contacts and self.contactors:
@@ -203,5 +192,5 @@ class StateSpace(ProblemSpace):
                 T = P + C.T @ np.linalg.pinv(C @ C.T) @ (D - C @ P)
             else:
                 T = P
-            self._proj[key] = T  # type: ignore[index]
+            self._proj[key] = T
         return T
