@@ -41,7 +41,7 @@ def main() -> None:
     ds = ib.bifurcation_map(sc, ("excitation.frequency", np.linspace(30.0, 90.0, 121)),
                             ("excitation.amplitude", np.linspace(0.5 * G, 4.0 * G, 36)),
                             ROOT / "out" / "periodic_map.zarr", settle_periods=100, record_periods=20)
-    from impactbeam.periodic.maps import plot_map
+    from impactbeam.plot.periodic import plot_map
 
     plot_map(ds, FIG / "periodic_map.png")
     for diagram in (d, a):

@@ -118,3 +118,71 @@ def test_sizes(name: str) -> None:
         and node.end_lineno - node.lineno + 1 > MAX_FUNCTION_LINES
     ]
     assert not long, f"{name}: functions over {MAX_FUNCTION_LINES} lines: {', '.join(long)}"
+
+
+# --------------------------------------------------------------------------- layers (docs/architecture.md)
+
+FOUNDATION = {"exceptions", "units", "_io", "_optional", "_validation", "_warnings", "_memory", "_html"}
+#: what each package or top-level module may import besides the foundation (docs/architecture.md, "Layers")
+MAY_IMPORT: dict[str, set[str]] = {
+    "model": set(),
+    "scenario": {"model"},
+    "modal": {"model", "scenario"},
+    "solver": {"model", "modal"},
+    "result": {"model", "modal", "solver", "plot"},  # plot: SimulationResult.plot() forwards to the figure
+    "plot": {"model", "modal", "result"},
+    "simulation": {"model", "scenario", "solver", "result"},
+    "sweeps": {"model", "scenario", "modal", "solver", "result", "plot", "simulation"},
+    "periodic": {"model", "scenario", "modal", "solver", "result", "plot", "simulation", "sweeps"},
+    "experiment": {"model", "scenario", "modal", "solver", "result", "plot", "simulation"},
+    "fit": {"model", "scenario", "modal", "solver", "result", "plot", "simulation", "experiment"},
+    "explore": {"model", "scenario", "modal", "solver", "result", "plot", "simulation"},
+    "paper": {"model", "scenario", "modal", "solver", "result", "plot", "simulation", "experiment"},
+}
+
+
+def _part(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def test_the_top_level_holds_packages_and_at_most_ten_modules() -> None:
+    loose = sorted(p.name for p in PACKAGE.glob("*.py") if p.name not in ("__init__.py", "__main__.py"))
+    assert len(loose) <= 10, f"{len(loose)} modules directly under impactbeam/: {loose}"
+
+
+def test_every_package_imports_only_the_layers_below_it() -> None:
+    # Reason: the layer table of docs/architecture.md, checked on every import
+    # (module level, functions, TYPE_CHECKING). A new package must be added here
+    # with what it may use.
+    bad = []
+    for name, path in MODULES.items():
+        part = _part(name)
+        if part in FOUNDATION or part in ("", "cli", "__main__"):
+            if part in FOUNDATION:
+                bad += [f"{name} -> {t}" for t in _imports(name, path) if _part(t) not in FOUNDATION]
+            continue
+        assert part in MAY_IMPORT, f"{part}: a package missing from the layer table"
+        allowed = MAY_IMPORT[part] | FOUNDATION | {part}
+        bad += [f"{name} -> {t}" for t in _imports(name, path) if _part(t) not in allowed]
+    assert not bad, "imports against the layers:\n" + "\n".join(bad)
+
+
+def test_the_layer_check_sees_a_wrong_import() -> None:
+    # Reason: the check must be able to fail: a model module that imports the solver is caught.
+    assert _part("impactbeam.solver.engine") not in MAY_IMPORT["model"]
+
+
+def test_simulate_does_not_import_matplotlib() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, impactbeam as ib\n"
+        "sc = ib.parse_scenario({'beam': {'length': 0.1, 'width': 0.01, 'height': 0.003, 'youngs_modulus': 2e9,"
+        " 'density': 950}, 'solver': {'modes': 2, 'end_time': 0.001}})\n"
+        "ib.simulate(sc).metrics()\n"
+        "print('matplotlib' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False", out.stdout + out.stderr

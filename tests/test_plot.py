@@ -76,7 +76,9 @@ def test_series_styles_differ_without_colour():
 
 
 def test_plot_result_on_given_axes(case3):
-    fig, grid = plot._new_figure((4, 3))
+    from impactbeam.plot.figure import _new_figure
+
+    fig, grid = _new_figure((4, 3))
     h = plot.plot_result(case3, ax=grid[0, 0])
     assert h.axes[0] is grid[0, 0] and len(h.axes) == 2  # twin axis for the force
     assert h.figure is fig
@@ -164,7 +166,7 @@ def test_result_plot_forwards(case3, tmp_path):
     ],
 )
 def test_sweep_axis_labels_are_readable(name, units, label, scale):
-    from impactbeam._plotstyle import display_label
+    from impactbeam.plot.style import display_label
 
     assert display_label(name, units) == (label, scale)
 

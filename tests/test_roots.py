@@ -1,4 +1,4 @@
-"""Brent's method in plain Python (impactbeam._roots) against SciPy's brentq.
+"""Brent's method in plain Python (impactbeam.modal.roots) against SciPy's brentq.
 
 Both implement the same algorithm, so on the same bracket and tolerances the
 roots agree to the convergence tolerance (here 4 eps relative): functions
@@ -10,7 +10,7 @@ import math
 import pytest
 from scipy.optimize import brentq as scipy_brentq
 
-from impactbeam._roots import brentq
+from impactbeam.modal.roots import brentq
 
 CASES = [
     (lambda x: math.cos(x) - x, 0.0, 1.0),

@@ -1,8 +1,8 @@
-"""The exact static solver (impactbeam._static) against independent references.
+"""The exact static solver (impactbeam.modal.static) against independent references.
 
-The moment of the mode-acceleration correction (impactbeam.stress) rests on
+The moment of the mode-acceleration correction (impactbeam.result.stress) rests on
 it. References: the polynomial statics of the uniform beam with end springs
-(impactbeam.solver.statics, another formulation: the fourth-order equation
+(impactbeam.modal.uniform_static, another formulation: the fourth-order equation
 integrated as polynomials with the end conditions as rows), equilibrium of
 statically determinate beams, and the Timoshenko propped cantilever by
 compatibility of tip deflections.
@@ -16,10 +16,10 @@ import itertools
 import numpy as np
 import pytest
 
-from impactbeam._static import static_moment
+from impactbeam.modal import static_moment
 from impactbeam.exceptions import ParameterError
 from impactbeam.model.beam import Beam, Section, Support
-from impactbeam.solver.statics import static_polynomial
+from impactbeam.modal import static_polynomial
 
 L = 0.3
 X = np.linspace(0.0, L, 13)

@@ -1,4 +1,4 @@
-"""Bending moment and stress (impactbeam.stress): the mode-acceleration static correction.
+"""Bending moment and stress (impactbeam.result.stress): the mode-acceleration static correction.
 
 Independent checks: the static moment of a cantilever under a tip force
 (``M(x) = F (L - x)``, beam theory), the free end's zero moment, the outer-fibre
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import impactbeam as ib
-from impactbeam._static import static_moment
+from impactbeam.modal import static_moment
 from impactbeam.exceptions import ImpactBeamWarning, ParameterError
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -400,7 +400,7 @@ def test_modes_cli_json_and_plot_of_a_structure(tmp_path):
 
 
 def test_plot_modes_marks_the_structure():
-    from impactbeam import modeplot
+    from impactbeam.plot import modes as modeplot
 
     sc = ib.parse_scenario(__import__("tomllib").loads(STRUCTURE))
     ms = ib.modes(sc).free

@@ -32,7 +32,7 @@ from click.testing import CliRunner
 
 import impactbeam as ib
 from impactbeam.exceptions import ScenarioError
-from impactbeam.metrics import METRIC_UNITS
+from impactbeam.result.metrics import METRIC_UNITS
 from impactbeam.sweeps import (
     load_sweep,
     parse_sweep,
@@ -188,7 +188,7 @@ values = [0.01]
     assert chunk == (1, 3, 1)  # 5 gaps in two equal-ish batches (3 + 2), one height each
     regions = list(_regions(spec.shape, chunk))
     assert len(regions) == 4  # 2 heights x 2 gap batches
-    from impactbeam.modal import _cached
+    from impactbeam.modal.modeset import _cached
     from impactbeam.solver.ritz import _cached_basis  # the shared basis of solver.basis = "enriched"
 
     from impactbeam.solver import engine

@@ -45,8 +45,8 @@ _EXPORTS: dict[str, str] = {
     "mode_set": "modal",
     "scenario_modes": "modal",
     "modes": "modal",
-    "simulate": "solver",
-    "simulate_system": "solver",
+    "simulate": "simulation",
+    "simulate_system": "simulation",
     "SimulationResult": "result",
     "Event": "solver",
     "write_result": "result",
@@ -105,7 +105,8 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .modal import ModeSet, ScenarioModes, mode_set, modes, scenario_modes
     from .result import SimulationResult, write_result
     from .scenario import Scenario, load_scenario, parse_scenario
-    from .solver import Event, simulate, simulate_system
+    from .simulation import simulate, simulate_system
+    from .solver import Event
     from .experiment import Identification, identify
     from .periodic.shooting import PeriodicOrbit, periodic_orbit
     from .periodic.bifurcation import BifurcationDiagram, bifurcation

@@ -39,7 +39,7 @@ import numpy as np
 
 from ._optional import require
 from .exceptions import ParameterError
-from .metrics import METRIC_DISPLAY
+from .result.metrics import METRIC_DISPLAY
 from .scenario import Scenario, parse_scenario
 
 __all__ = ["SLIDERS", "ExplorerModel", "ExplorerPage", "Slider", "build_app", "curves", "envelope", "envelope_index", "serve"]
@@ -196,7 +196,7 @@ class ExplorerModel:
         the same samples (``k max(-(gap + u), 0)`` while engaged) instead of
         the result's full output grid of every point.
         """
-        from .solver import simulate
+        from .simulation import simulate
 
         sc = self.scenario()
         t0 = time.perf_counter()
@@ -507,7 +507,7 @@ class ExplorerPage:
             True if it ran, False if these modes were prepared already or the
             scenario rejects them.
         """
-        from .solver import simulate
+        from .simulation import simulate
 
         values = dict(self.model.values, modes=int(count))
         key = tuple(sorted(values.items()))

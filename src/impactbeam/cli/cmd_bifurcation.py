@@ -190,7 +190,8 @@ def bifurcation_map_command(scenario: str, x_key: str, x_values: str | None, x_s
         raise ParameterError(f"--record-periods: must be >= 2, got {record}")
     if workers is not None and workers < 0:
         raise ParameterError(f"--workers: must be >= 0, got {workers}")
-    from ..periodic.maps import bifurcation_map, plot_map
+    from ..periodic.maps import bifurcation_map
+    from ..plot.periodic import plot_map
 
     sc = load_with_overrides(scenario)
     xs = _values(x_key, x_values, x_span, sc, "--x")

@@ -45,7 +45,7 @@ def modes(scenario: str, count: int | None, as_json: bool, plot_path: str | None
     free = [float(f) for f in ms.free.frequencies_hz]
     contact = None if ms.contact is None else [float(f) for f in ms.contact.frequencies_hz]
     if plot_path is not None:
-        from ..modeplot import plot_modes
+        from ..plot.modes import plot_modes
 
         plot_modes(ms.free, count=min(n, 6), contactors=sc.contactors, path=plot_path,
                    title=f"{sc.name}: free-state mode shapes")

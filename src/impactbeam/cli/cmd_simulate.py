@@ -53,7 +53,7 @@ def simulate(
         scenario,
         {"solver.modes": modes, "solver.time_step": time_step, "solver.end_time": end_time},
     )
-    from ..solver import simulate as run
+    from ..simulation import simulate as run
 
     # import the writers before the (possibly long) run, so a broken install fails fast
     from .._optional import require
@@ -70,7 +70,7 @@ def simulate(
         check_output_size(n_t, len(sc.output_points), len(sc.contactors), n_m)  # before any work
     if plot is not None:
         require("matplotlib", "plot", feature="--plot")
-        from ..plot import plot_result
+        from ..plot.response import plot_result
 
     with progress_bar(sc.solver.end_time, desc="simulate", unit="s", unit_scale=True,
                       bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s simulated "
@@ -114,7 +114,7 @@ def _number(value: Any) -> float | None:
 
 
 def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
-    from ..metrics import METRIC_DISPLAY
+    from ..result.metrics import METRIC_DISPLAY
 
     if sc.contactors:
         c = sc.contactors[0]

@@ -21,7 +21,7 @@ A :class:`Record` is one channel against time, in SI units: a deflection
 Sign convention: a deflection record holds ``w`` at one point of the beam in
 the model's convention (see the model page: measured from the rest position,
 positive along +w). The comparison quantities are computed, as the metrics
-of :mod:`impactbeam.metrics`, on ``u`` positive away from the first
+of :mod:`impactbeam.result.metrics`, on ``u`` positive away from the first
 contactor (``u = -w`` for a contactor "above"), so a contact shows as ``u``
 below ``-gap``.
 """

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from .._optional import require
-from ..metrics import response_point
+from ..result.metrics import response_point
 from ..exceptions import ParameterError, SimulationError
 if TYPE_CHECKING:
     from ..model.loading import Excitation
@@ -290,7 +290,7 @@ class Comparison:
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, lw=0.3)
         if path is not None:
-            from .._figure import save_figure
+            from ..plot.figure import save_figure
 
             save_figure(fig, path, dpi=130, bbox_inches="tight")
         return fig, ax, lines
@@ -383,7 +383,7 @@ def compare(
     computed the same way on both: on the measured samples and on the
     simulation's output grid (``solver.time_step``).
     """
-    from ..solver import simulate
+    from ..simulation import simulate
 
     sc, meas = prepare_run(scenario, measured, excitation, hold, window)
     x = record_point(sc, point)

@@ -111,7 +111,7 @@ def fit(
     """
     lmfit = require("lmfit", "fit")
 
-    from ..solver import simulate
+    from ..simulation import simulate
 
     paths, user_bounds = _checked_params(params, bounds, max_nfev, scenario.excitation.kind)
     base, meas = prepare_run(scenario, measured, None, hold, window)

@@ -185,7 +185,7 @@ class Beam:
         Permanent interior (or end) springs, added to the end supports at an end.
     theory : {"euler-bernoulli", "timoshenko"}
         Euler-Bernoulli (the paper's eq. 1, default) or Timoshenko (shear
-        deformation and rotary inertia, :mod:`impactbeam._timoshenko`).
+        deformation and rotary inertia, :mod:`impactbeam.modal.timoshenko`).
     poisson_ratio : float or None
         Poisson's ratio, in (-1, 0.5); a Timoshenko beam needs it (the shear
         modulus of each section is ``G = E / (2 (1 + nu))``).

@@ -111,7 +111,7 @@ def paper_metrics(result: SimulationResult, *, free_period: float | None = None)
         Free-state fundamental period used to group impacts into cycles
         (default: computed from the result's beam).
     """
-    from ..metrics import contact_intervals
+    from ..result.metrics import contact_intervals
     from ..modal import mode_set
 
     m = result.metrics()

@@ -14,8 +14,8 @@ __all__ = []
 
 def _figures(data: dict[str, Any], fig_dir: Path, tick: Callable[[str], None]) -> dict[str, Path]:
     from .. import plot as P
-    from .._figure import _new_figure
-    from .._plotstyle import _outside_legend
+    from ..plot.figure import _new_figure
+    from ..plot.style import _outside_legend
 
     res = data["results"]
     scs = data["scenarios"]

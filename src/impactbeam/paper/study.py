@@ -67,7 +67,7 @@ class _Runner:
 
     def run(self, sc: Scenario, label: str = "") -> SimulationResult:
         from ..exceptions import SimulationError
-        from ..solver import simulate
+        from ..simulation import simulate
 
         k = self.key(sc)
         if k not in self._cache:

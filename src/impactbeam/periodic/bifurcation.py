@@ -32,7 +32,7 @@ from .strobe import PERIOD_TOLERANCE, SteadyState, count, harmonic_period, settl
 if TYPE_CHECKING:
     from ..scenario import Scenario
 
-__all__ = ["BifurcationPoint", "BifurcationDiagram", "bifurcation", "parameter_values", "plot_bifurcation"]
+__all__ = ["BifurcationPoint", "BifurcationDiagram", "bifurcation", "parameter_values"]
 
 Direction = Literal["up", "down", "both"]
 
@@ -135,15 +135,17 @@ class BifurcationDiagram:
             ds.to_netcdf(tmp, engine="h5netcdf")
 
     def plot(self, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
-        """The diagram (see :func:`plot_bifurcation`); written to ``path`` when given.
+        """The diagram (see :func:`~impactbeam.plot.periodic.plot_bifurcation`); written to ``path`` when given.
 
         Parameters
         ----------
         path : str or path-like, optional
             Also write the figure there (format from the suffix).
         **kwargs
-            Passed to :func:`plot_bifurcation`.
+            Passed to :func:`~impactbeam.plot.periodic.plot_bifurcation`.
         """
+        from ..plot.periodic import plot_bifurcation
+
         return plot_bifurcation(self, path, **kwargs)
 
 
@@ -299,52 +301,3 @@ def _unit(dimension: str) -> str:
     from ..units import DIMENSIONS
 
     return DIMENSIONS[dimension].si_unit if dimension in DIMENSIONS else ""
-
-
-def plot_bifurcation(diagram: BifurcationDiagram, path: str | os.PathLike[str] | None = None, *,
-                     axes: Any = None, scale: float = 1e3) -> Any:
-    """The classic diagram: strobe samples against the parameter, impacts per period beneath.
-
-    Up and down sweeps are drawn in two colours. ``scale`` multiplies w
-    (default 1e3: mm). Returns the figure; with ``path`` it is also written
-    (and closed).
-    """
-    import matplotlib.pyplot as plt
-
-    from .._plotstyle import display_label
-
-    xlabel, xs = display_label(diagram.parameter, diagram.unit)
-    if axes is None:
-        fig, axes = plt.subplots(2, 1, sharex=True, figsize=(7.0, 5.6), height_ratios=(3, 1), layout="constrained")
-    fig = axes[0].figure
-    colors = {"up": "tab:blue", "down": "tab:orange"}
-    offset = {"up": -0.12, "down": 0.12}
-    vals = np.array([p.value for p in diagram.points]) * xs
-    step = float(np.min(np.diff(np.unique(vals)))) if np.unique(vals).size > 1 else 1.0
-    for direction in ("up", "down"):
-        pts = [p for p in diagram.points if p.direction == direction]
-        if not pts:
-            continue
-        x = np.concatenate([np.full(p.state.strobe.size, p.value * xs) for p in pts])
-        y = np.concatenate([p.state.strobe for p in pts]) * scale
-        if direction == "up":  # hollow circles, so the down sweep's dots show inside where they agree
-            axes[0].scatter(x, y, s=10.0, facecolors="none", edgecolors=colors[direction], linewidths=0.6,
-                            label="sweep up")
-        else:
-            axes[0].scatter(x, y, s=2.0, color=colors[direction], linewidths=0, label="sweep down")
-        xi = np.array([p.value for p in pts]) * xs + offset[direction] * step
-        axes[1].plot(xi, [p.state.impacts_per_period if p.state.period else np.nan for p in pts], "o", ms=2.5,
-                     color=colors[direction])
-        bad = [p for p in pts if not p.state.period]
-        if bad:
-            axes[1].plot([p.value * xs for p in bad], [p.state.impacts_per_period for p in bad], "x", ms=3,
-                         color=colors[direction], label=f"{direction}: no period")
-    axes[0].set_ylabel("w at strobe point [mm]" if scale == 1e3 else "w at strobe point")
-    axes[0].legend(loc="best", fontsize="small", markerscale=2)
-    axes[1].set_ylabel("impacts / period")
-    axes[1].set_xlabel(xlabel)
-    if path is not None:
-        from .._figure import save_and_close
-
-        save_and_close(fig, path)
-    return fig

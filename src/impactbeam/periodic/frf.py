@@ -31,8 +31,7 @@ if TYPE_CHECKING:
     from ..scenario import Scenario
     from ..solver.solution import ModalState
 
-__all__ = ["FrequencyResponse", "frequency_response", "from_diagram", "linear_frf", "linear_steady_state",
-           "plot_frequency_response"]
+__all__ = ["FrequencyResponse", "frequency_response", "from_diagram", "linear_frf", "linear_steady_state"]
 
 
 def _free_state(scenario: Scenario) -> tuple[Any, Any]:
@@ -140,6 +139,8 @@ class FrequencyResponse:
         **kwargs
             Passed to the plotting function.
         """
+        from ..plot.periodic import plot_frequency_response
+
         return plot_frequency_response(self, path, **kwargs)
 
 
@@ -194,37 +195,3 @@ def from_diagram(scenario: Scenario, d: BifurcationDiagram) -> FrequencyResponse
         impacts_per_period=np.array([p.state.impacts_per_period for p in d.points]),
         linear=lin, point=strobe_point(scenario), warnings=list(d.warnings),
     )
-
-
-def plot_frequency_response(fr: FrequencyResponse, path: str | os.PathLike[str] | None = None, *,
-                            ax: Any = None, scale: float = 1e3, gap: float | None = None) -> Any:
-    """max and min of ``w`` against frequency, up and down sweeps, the linear FRF dashed.
-
-    ``gap`` [m] draws the contactor's clearance as a horizontal line.
-    Returns the figure; with ``path`` it is written (atomically) and closed.
-    """
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(7.0, 4.4), layout="constrained")
-    fig = ax.figure
-    order = np.argsort(fr.frequency, kind="stable")
-    fs = fr.frequency[order]
-    ax.plot(fs, fr.linear[order] * scale, "k--", lw=0.8, label="linear FRF |H| A (no contact)")
-    ax.plot(fs, -fr.linear[order] * scale, "k--", lw=0.8)
-    for direction, color, mk in (("up", "tab:blue", "^"), ("down", "tab:orange", "v")):
-        m = fr.direction == direction
-        if m.any():
-            ax.plot(fr.frequency[m], fr.max[m] * scale, mk, ms=3, color=color, label=f"max, sweep {direction}")
-            ax.plot(fr.frequency[m], fr.min[m] * scale, mk, ms=3, color=color, mfc="none",
-                    label=f"min, sweep {direction}")
-    if gap is not None:
-        ax.axhline(gap * scale, color="0.5", lw=0.8, ls=":", label="gap")
-    ax.set_xlabel("forcing frequency [Hz]")
-    ax.set_ylabel("w at the strobe point [mm]" if scale == 1e3 else "w at the strobe point")
-    ax.legend(fontsize="small", loc="best")
-    if path is not None:
-        from .._figure import save_and_close
-
-        save_and_close(fig, path)
-    return fig

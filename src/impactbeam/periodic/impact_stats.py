@@ -9,7 +9,7 @@ each contactor:
   velocity at the contactor; not a material constant: the contactor is a
   spring and the beam flexes);
 * peak force [N] and impulse [N s] (exact, closed form, as
-  :mod:`impactbeam.metrics`);
+  :mod:`impactbeam.result.metrics`);
 * over the record: mean and RMS contact force [N] (time averages over the
   record, zero while open), and the impact work rate [W], the mean of
   ``|F v|`` over the time in contact; ``F^2`` and ``|F v|`` are integrated

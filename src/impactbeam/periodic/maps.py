@@ -32,7 +32,7 @@ from .strobe import PERIOD_TOLERANCE, count, harmonic_period
 if TYPE_CHECKING:
     from ..scenario import Scenario
 
-__all__ = ["bifurcation_map", "map_row", "plot_map"]
+__all__ = ["bifurcation_map", "map_row"]
 
 
 def map_row(data: dict[str, Any], base_dir: str | None, x_key: str, x_values: list[float], y_key: str,
@@ -219,34 +219,3 @@ def _run_on_dask(todo: list[int], args: list[tuple], store: Callable[[int, dict]
                 store(row_of[fut.key], row)
         finally:
             client.cancel(futures)
-
-
-def plot_map(ds: Any, path: str | os.PathLike[str] | None = None) -> Any:
-    """Two panels over (x, y): the response period (0: none found) and the impacts per period.
-
-    Returns the figure; with ``path`` it is written (atomically) and closed.
-    """
-    import matplotlib.pyplot as plt
-
-    from .._plotstyle import display_label
-
-    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.0), sharey=True, layout="constrained")
-    xlabel, xs = display_label(ds.attrs["x_parameter"], ds["x"].attrs.get("units"))
-    ylabel, ys = display_label(ds.attrs["y_parameter"], ds["y"].attrs.get("units"))
-    x, y = ds["x"].values * xs, ds["y"].values * ys
-    period = np.where(ds["done"].values[:, None], ds["period"].values, -1).astype(float)
-    period[period < 0] = np.nan
-    top = max(2, int(np.nanmax(period)) if np.isfinite(period).any() else 2)
-    cmap = plt.get_cmap("tab10", top + 1)
-    m0 = axes[0].pcolormesh(x, y, period, shading="nearest", cmap=cmap, vmin=-0.5, vmax=top + 0.5)
-    fig.colorbar(m0, ax=axes[0], label="period (0: none found)", ticks=range(top + 1))
-    m1 = axes[1].pcolormesh(x, y, ds["impacts_per_period"].values, shading="nearest", cmap="viridis")
-    fig.colorbar(m1, ax=axes[1], label="impacts per period")
-    for ax in axes:
-        ax.set_xlabel(xlabel)
-    axes[0].set_ylabel(ylabel)
-    if path is not None:
-        from .._figure import save_and_close
-
-        save_and_close(fig, path)
-    return fig

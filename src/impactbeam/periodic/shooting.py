@@ -207,7 +207,7 @@ class StroboscopicMap:
 
 
 def _check(scenario: Scenario, multiple: Any) -> int:
-    from ..solver import _require_scenario
+    from ..simulation import _require_scenario
 
     _require_scenario(scenario)
     if isinstance(multiple, bool) or not isinstance(multiple, (int, np.integer)) and not (
@@ -246,7 +246,7 @@ def _section_phase(sol: Any, lo: float, hi: float, start: float, f: float, prefe
 
 def _settle(scenario: Scenario, multiple: int, settle_periods: float | None) -> tuple[Any, float, int]:
     """The plain simulation the search starts from, its end time and the modes per state."""
-    from ..solver import simulate
+    from ..simulation import simulate
 
     exc = scenario.excitation
     f = float(exc.frequency)

@@ -291,7 +291,7 @@ def run_periods(scenario: Scenario, periods: int, *, start_state: ModalState | N
     run that ended a whole number of periods after its load began, so the
     phase of the load carries on.
     """
-    from ..solver import simulate
+    from ..simulation import simulate
 
     T = harmonic_period(scenario)
     ex = scenario.excitation

@@ -295,8 +295,20 @@ def integrate(
 ) -> Solution:
     """Run the exact event-driven integration; see :func:`impactbeam.simulate`.
 
-    ``start``: free-state modal displacement and velocity at t = 0 (replaces
-    ``initial``); see :meth:`Solution.modal_state`.
+    Parameters
+    ----------
+    beam : Beam
+    contactors : tuple of Contactor
+    damping : Damping
+    excitation : Excitation
+    initial : InitialCondition
+        The state at t = 0 (unless ``start`` is given).
+    options : SolverOptions
+    progress : callable, optional
+        Called with the simulated time at every checkpoint.
+    start : tuple of ndarray, optional
+        Free-state modal displacement and velocity at t = 0 (replaces
+        ``initial``); see :meth:`Solution.modal_state`.
 
     Returns
     -------

@@ -44,7 +44,7 @@ integrated in closed form; a switch is the exact change of coordinates
 velocity and energy continuous to round-off) instead of eq. (12).
 
 The static shape is the exact piecewise cubic of the beam with its end springs
-(DESIGN.md section 1, springs 0..inf). When the supports allow rigid-body
+(the paper's end conditions, springs 0..inf). When the supports allow rigid-body
 motion (free-free, pinned-free, sliding-free...) no static solution exists;
 then **inertia relief** is used: the unit force is balanced by the d'Alembert
 load of the rigid-body modes, ``EI g'''' = delta_a - rho A sum_r phi_r(x)
@@ -52,7 +52,7 @@ phi_r(a)`` (a piecewise quintic), and the rigid-body part of ``g`` is removed.
 
 Any other beam of the model its supports hold (sections, point masses,
 interior springs, Timoshenko) gets its static shape from the exact static
-solver (:mod:`impactbeam._static`), and every inner product of the basis is
+solver (:mod:`impactbeam.modal.static`), and every inner product of the basis is
 the kinetic one of that beam: ``rho A(x)`` on the quadrature, ``rho I(x)`` on
 the rotations of a Timoshenko beam, ``m`` and ``J`` at the point masses. Such
 a beam that can move as a rigid body keeps the paper's basis.
@@ -81,9 +81,7 @@ import numpy as np
 import scipy.linalg
 
 from ..model.beam import Beam
-from ..modal import ModeSet, mode_set
-from .._static import static_state
-from .statics import static_coefficients
+from ..modal import ModeSet, mode_set, static_coefficients, static_state
 
 __all__ = ["RitzBasis", "ritz_basis"]
 
@@ -342,7 +340,7 @@ class RitzBasis:
 
         The paper's uniform beam: the polynomials (inertia relief with
         rigid-body modes); any other beam its supports hold: the exact static
-        solver (:func:`impactbeam._static.static_state`).
+        solver (:func:`impactbeam.modal.static.static_state`).
         """
         beam, L = self.beam, self.beam.length
         x = np.atleast_1d(np.asarray(x, dtype=float))

@@ -4,7 +4,7 @@ Like SciPy's ``OdeSolution``, a solution is a list of segments, each with its
 own closed form; it can be evaluated at any time, not only at output
 samples. :class:`Solution` is what :func:`~impactbeam.solver.engine.integrate`
 returns; :class:`PiecewiseSolution` is the interface that
-:class:`~impactbeam.result.SimulationResult` and :mod:`~impactbeam.metrics`
+:class:`~impactbeam.result.SimulationResult` and :mod:`~impactbeam.result.metrics`
 use, which the ``solve_ivp`` reference path implements too.
 """
 
@@ -67,7 +67,17 @@ class ModalState:
 
 
 def basis_signature(beam: Any, contactors: Any, modes: int, basis: str) -> tuple:
-    """What the free state's modal basis depends on (see :class:`ModalState`)."""
+    """What the free state's modal basis depends on (see :class:`ModalState`).
+
+    Parameters
+    ----------
+    beam : Beam
+    contactors : sequence of Contactor
+        Their positions enter the enriched basis (its attachment shapes).
+    modes : int
+        Retained modes per state.
+    basis : {"enriched", "paper"}
+    """
     positions = tuple(float(c.position) for c in contactors) if basis == "enriched" else ()
     return (beam, positions, int(modes), basis)
 

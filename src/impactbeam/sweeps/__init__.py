@@ -51,7 +51,7 @@ from __future__ import annotations
 
 from .batches import run_batch
 from .parse import load_sweep, parse_sweep
-from .plot import plot_sweep, select_cases
+from ..plot.sweep import plot_sweep, select_cases
 from .run import SweepInterrupted, SweepRun, run_sweep, sweep
 from .spec import DESIGNS, DISTRIBUTIONS, FAILED, NOT_RUN, STATUS_CODES, SweepParameter, SweepSpec
 

@@ -144,7 +144,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     batch : _Batch
         The cases of one chunk of the store.
     """
-    from ..solver import simulate
+    from ..simulation import simulate
 
     _tune_malloc()
     n = len(batch.values)

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import ScenarioError
-from ..metrics import METRIC_UNITS
+from ..result.metrics import METRIC_UNITS
 from ..scenario import Scenario, load_scenario, parse_scenario, path_dimension
 from ..scenario.schema import describe_value
 from ..units import to_si

@@ -14,7 +14,7 @@ import numpy as np
 from .._io import pid_alive
 from .._optional import require
 from ..exceptions import ParameterError
-from ..metrics import METRIC_UNITS
+from ..result.metrics import METRIC_UNITS
 if TYPE_CHECKING:
     import xarray as xr
 from .spec import NOT_RUN, STATUS_CODES, SweepSpec

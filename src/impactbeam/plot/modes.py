@@ -8,14 +8,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._figure import PlotHandles, _finish, _new_figure
+from .figure import PlotHandles, _finish, _new_figure
 
 _MM = 1e3
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from .modal import ModeSet
+    from ..modal import ModeSet
 
 __all__ = ["plot_modes"]
 

@@ -2,7 +2,7 @@
 
 Styled like :mod:`impactbeam.plot` (journal sizes, line styles that survive
 grey-scale, legends outside the data); returned as
-:class:`~impactbeam._figure.PlotHandles`.
+:class:`~impactbeam.plot.figure.PlotHandles`.
 """
 
 from __future__ import annotations
@@ -14,10 +14,10 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from ._figure import PlotHandles, _finish, _new_figure
-from ._optional import require
-from .exceptions import ParameterError
-from ._plotstyle import SERIES_STYLES, _log_ticks, _outside_legend, _side_legend, _styled, _wrap, figure_size
+from .figure import PlotHandles, _finish, _new_figure
+from .._optional import require
+from ..exceptions import ParameterError
+from .style import SERIES_STYLES, _log_ticks, _outside_legend, _side_legend, _styled, _wrap, figure_size
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -6,8 +6,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._optional import require
-from .exceptions import ParameterError
+from .._optional import require
+from ..exceptions import ParameterError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -19,7 +19,7 @@ same instant (piecewise polynomial). The truncated modal sum then only carries
 the dynamic part, which converges fast; at a static limit the moment is exact
 for any number of modes.
 
-The static moment (:mod:`impactbeam._static`) is exact for every beam of the
+The static moment (:mod:`impactbeam.modal.static`) is exact for every beam of the
 model its supports hold (sections, springs, point masses, Timoshenko). A beam
 that can move as a rigid body has no static solution: the plain modal sum is
 returned with a warning.
@@ -34,12 +34,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._static import static_moment
-from ._warnings import emit_user_level_warning
-from .exceptions import ImpactBeamWarning
+from ..modal import static_moment
+from .._warnings import emit_user_level_warning
+from ..exceptions import ImpactBeamWarning
 
 if TYPE_CHECKING:
-    from ._typing import ResultLike
+    from .protocol import ResultLike
 
 __all__ = ["bending_moment", "bending_stress", "max_bending_stress", "SAMPLES_PER_PERIOD"]
 

@@ -14,7 +14,7 @@ integrates to polynomials of degree four. The beam is cut at its nodes
 exact stiffness and fixed-end forces are assembled with the node springs
 (an infinite one fixes its degree of freedom) and solved, and the moment
 anywhere is the piece's polynomial. This is the ``M_st`` of the
-mode-acceleration correction of :mod:`impactbeam.stress`.
+mode-acceleration correction of :mod:`impactbeam.result.stress`.
 
 References
 ----------
@@ -30,9 +30,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._exact import layout
-from .exceptions import ParameterError
-from .model.beam import Beam
+from .euler import layout
+from ..exceptions import ParameterError
+from ..model.beam import Beam
 
 __all__ = ["static_moment", "static_state"]
 
@@ -111,8 +111,18 @@ def static_state(beam: Beam, x: Sequence[float] | np.ndarray, forces: Sequence[t
     Returns ``(W, Psi, M, V, W1, W2, W3)``: deflection [m], cross-section
     rotation (``W'`` for Euler-Bernoulli), moment ``M = EI Psi'`` [N m], shear
     ``V = -M'`` [N], and the first three x-derivatives of ``W`` (from
-    ``W' = Psi + V / kappa G A``). Parameters as :func:`static_moment`; at a
-    node, the values to the right.
+    ``W' = Psi + V / kappa G A``); at a node, the values to the right.
+
+    Parameters
+    ----------
+    beam : Beam
+        A beam its supports hold (no rigid-body motion).
+    x : array_like, (n,), [m]
+        Where to evaluate.
+    forces : sequence of (position [m], force [N])
+        Point forces, positive along +w.
+    per_length : sequence of float, [N/m], optional
+        A uniform distributed load on each section (default none).
     """
     pieces = beam.pieces()
     q = tuple(float(v) for v in (per_length if per_length is not None else [0.0] * len(pieces)))

@@ -8,7 +8,6 @@ import numpy as np
 
 from .._optional import require
 from ..exceptions import ParameterError
-from .spec import _plain
 
 __all__ = ["plot_sweep", "select_cases"]
 
@@ -19,7 +18,7 @@ def _axis_label(ds: Any, name: str) -> str:
 
 def _axis(ds: Any, name: str) -> tuple[str, float]:
     """Display label ("gap [mm]") and the factor from the stored SI values."""
-    from .._plotstyle import display_label
+    from .style import display_label
 
     return display_label(name, ds[name].attrs.get("units"))
 
@@ -69,7 +68,7 @@ def select_cases(ds: Any, keep: Sequence[str], sel: Mapping[str, Any] | None = N
                 i = int(matches[0])
         else:
             i = 0
-        chosen[dim] = _plain(coord[i])
+        chosen[dim] = np.asarray(coord[i]).item()  # a Python number or string
         ds = ds.isel({dim: i})
     return ds, chosen
 

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from ._io import json_text
+from .._io import json_text
 
 __all__ = ["result_dataset"]
 
@@ -31,7 +31,7 @@ def result_dataset(result: Any) -> Any:
 
     import xarray as xr
 
-    from . import __version__
+    from .. import __version__
 
     n_c = len(result.contactors)
     kind = np.array([1 if e.kind == "impact" else 0 for e in result.events], dtype=np.int8)

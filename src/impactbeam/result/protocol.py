@@ -1,6 +1,6 @@
-"""Structural types shared by the layers above the result.
+"""What the metrics, stresses and figures read of a simulation result: the protocol ``ResultLike``.
 
-:mod:`impactbeam.metrics`, :mod:`impactbeam.plot` and :mod:`impactbeam.stress` read a simulation result;
+:mod:`impactbeam.result.metrics`, :mod:`impactbeam.plot` and :mod:`impactbeam.result.stress` read a simulation result;
 :class:`~impactbeam.result.SimulationResult` calls them for its ``metrics()``
 and ``plot()`` methods. So that the import arrows run one way (result ->
 metrics, result -> plot, plot -> metrics), metrics and plot name the result by
@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 if TYPE_CHECKING:  # pragma: no cover - for type checkers
     import numpy as np
 
-    from .model.beam import Beam, Contactor
-    from .solver.solution import Event, PiecewiseSolution
+    from ..model.beam import Beam, Contactor
+    from ..solver.solution import Event, PiecewiseSolution
 
 __all__ = ["ResultLike"]
 

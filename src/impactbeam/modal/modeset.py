@@ -23,7 +23,7 @@ and at each interior node continuity of ``W, W'`` with the jumps
 ``[EI W'']^+_- = (K_t - J omega^2) W'`` and ``-[EI W''']^+_- = (k - m omega^2) W``
 (a spring alone: the paper's contact-state compatibilities; a section step:
 continuity of ``EI W''`` and ``EI W'''``; point masses at an end enter the end
-conditions the same way). :mod:`impactbeam._exact` builds the matrix, counts
+conditions the same way). :mod:`impactbeam.modal.euler` builds the matrix, counts
 and refines the roots.
 
 Every root is found exactly once: the Wittrick-Williams count
@@ -56,7 +56,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._exact import (
+from .euler import (
     Layout,
     _basis,
     bracket_roots,
@@ -69,12 +69,12 @@ from ._exact import (
     refine,
     rigid_modes,
 )
-from .model.beam import Beam
-from .exceptions import ParameterError
+from ..model.beam import Beam
+from ..exceptions import ParameterError
 
 if TYPE_CHECKING:
-    from ._timoshenko import TimoshenkoShapes
-    from .scenario import Scenario
+    from .timoshenko import TimoshenkoShapes
+    from ..scenario import Scenario
 
 __all__ = ["ModeSet", "ScenarioModes", "mode_set", "scenario_modes", "modes", "count_below"]
 
@@ -119,7 +119,7 @@ class ModeSet:
 
     def _repr_html_(self) -> str:
         """Compact summary table for Jupyter: the state's springs and first frequencies."""
-        from ._html import modeset_html
+        from .._html import modeset_html
 
         return modeset_html(self)
 
@@ -247,7 +247,7 @@ class ModeSet:
     def _beta_max(self) -> float:
         """Largest segment wavenumber of the set [1/m]."""
         if self._timo is not None and self._timo.omega.size:
-            from ._timoshenko import wavenumbers
+            from .timoshenko import wavenumbers
 
             return float(wavenumbers(self._timo.seg, float(self._timo.omega.max()))[0].max())
         return float(self.beta.max(initial=1.0 / self.beam.length) * np.max(self._layout.r))
@@ -353,7 +353,7 @@ def count_below(beam: Beam, omega: float, springs: Sequence[tuple[float, float]]
         Engaged contact springs, [m] and [N/m].
     """
     if beam.is_timoshenko:
-        from . import _timoshenko
+        from . import timoshenko as _timoshenko
 
         return _timoshenko.count_below(_timoshenko.segments(beam, layout(beam, springs)), float(omega))
     return _count_below_eb(beam, omega, springs)
@@ -381,7 +381,7 @@ def _build(lay: Layout, beam: Beam, springs: tuple[tuple[float, float], ...], co
     c2 = math.sqrt(lay.EI / lay.rhoA)
     timo = None
     if beam.is_timoshenko:
-        from . import _timoshenko
+        from . import timoshenko as _timoshenko
 
         timo = _timoshenko.solve(_timoshenko.segments(beam, lay), count - r, rigid.shape[0])
         betas = np.sqrt(timo.omega / c2)  # the Euler-Bernoulli-equivalent wavenumber, omega = beta^2 c
@@ -488,7 +488,7 @@ class ScenarioModes:
 
     def _repr_html_(self) -> str:
         """Both states side by side for Jupyter."""
-        from ._html import modeset_html
+        from .._html import modeset_html
 
         parts = [modeset_html(self.free).replace("ModeSet", "Free state", 1)]
         if self.contact is not None:

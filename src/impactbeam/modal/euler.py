@@ -42,9 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._roots import brentq
-from .model.beam import Beam
-from .exceptions import ModeSolveError, ParameterError
+from .roots import brentq
+from ..model.beam import Beam
+from ..exceptions import ModeSolveError, ParameterError
 
 _MERGE_DISTANCE = 3e-5  # fraction of L
 _GAUSS_ORDER = 20

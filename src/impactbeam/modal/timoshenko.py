@@ -56,10 +56,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._exact import Layout, bracket_wavenumbers
-from ._roots import brentq
-from .exceptions import ModeSolveError
-from .model.beam import Beam
+from .euler import Layout, bracket_wavenumbers
+from .roots import brentq
+from ..exceptions import ModeSolveError
+from ..model.beam import Beam
 
 __all__ = ["Segments", "TimoshenkoShapes", "segments", "solve"]
 
@@ -70,7 +70,7 @@ _J0_MARGIN = 0.9  # omega^2 C <= 0.9 < 1: clamped element frequencies stay above
 
 @dataclass(frozen=True)
 class Segments:
-    """Timoshenko properties of the uniform segments of a :class:`~impactbeam._exact.Layout`."""
+    """Timoshenko properties of the uniform segments of a :class:`~impactbeam.modal.euler.Layout`."""
 
     lay: Layout
     EI: np.ndarray  # [N m^2]

@@ -1,10 +1,9 @@
 """Exact static deflections of the paper's uniform beam with end springs, as polynomials.
 
 ``EI g'''' = q(x)`` with a unit point force, polynomial loads on the two
-sides of the force, and the end conditions of DESIGN.md section 1 (springs
-0..inf, exact at both limits). Used for the attachment shapes of the shared
-Ritz basis (:mod:`impactbeam.solver.ritz`) and the static moment of the
-mode-acceleration correction (:mod:`impactbeam.stress`).
+sides of the force, and the end conditions of the paper (after its eq. 5:
+springs 0..inf, exact at both limits). Used for the attachment shapes of
+the shared Ritz basis (:mod:`impactbeam.solver.ritz`).
 
 References
 ----------
@@ -58,8 +57,19 @@ def static_polynomial(beam: Beam, alpha: float, loads: np.ndarray, jump: float) 
     ``loads`` (2, m) holds the polynomial load of the segments left and right
     of ``xi = alpha``; ``jump`` is ``ghat'''(alpha+) - ghat'''(alpha-)`` (1 for a
     unit point force there, 0 for none); ``ghat, ghat', ghat''`` are continuous;
-    end conditions of DESIGN.md section 1. A singular system (rigid-body motion)
-    is solved in the least-squares sense; the caller removes the rigid-body part.
+    end conditions of the paper. A singular system (rigid-body motion) is
+    solved in the least-squares sense; the caller removes the rigid-body part.
+
+    Parameters
+    ----------
+    beam : Beam
+        A uniform beam with end springs.
+    alpha : float
+        Position of the point force, as a fraction of the length.
+    loads : ndarray, (2, m)
+        Polynomial load (powers of ``xi``) left and right of ``alpha``.
+    jump : float
+        Jump of the third derivative at ``alpha``.
     """
     m = loads.shape[1]
     part = np.zeros((2, m + 4))
@@ -93,5 +103,14 @@ def static_coefficients(beam: Beam, alpha: float, q0: float, q1: float) -> np.nd
     """Coefficients (2, 6) of ``ghat`` under a unit force at ``xi = alpha`` with ``ghat'''' = q0 + q1 xi``.
 
     The load is the inertia relief of rigid-body modes (zero without them).
+
+    Parameters
+    ----------
+    beam : Beam
+        A uniform beam with end springs.
+    alpha : float
+        Position of the unit force, as a fraction of the length.
+    q0, q1 : float
+        The distributed load ``q0 + q1 xi``.
     """
     return static_polynomial(beam, alpha, np.array([[q0, q1], [q0, q1]]), 1.0)

@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ._io import PLOT_SUFFIXES, atomic_path
-from ._optional import require
-from .exceptions import ParameterError
+from .._io import PLOT_SUFFIXES, atomic_path
+from .._optional import require
+from ..exceptions import ParameterError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -31,8 +31,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from ._typing import ResultLike
-    from .model.beam import Contactor
+    from .protocol import ResultLike
+    from ..model.beam import Contactor
 
 __all__ = ["compute_metrics", "contact_intervals", "response_point", "METRIC_UNITS", "METRIC_DISPLAY"]
 

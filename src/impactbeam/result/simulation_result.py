@@ -11,15 +11,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._io import RESULT_SUFFIXES, atomic_path
-from ._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
-from .model.beam import Beam, Contactor
-from .exceptions import ParameterError
+from .._io import RESULT_SUFFIXES, atomic_path
+from .._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
+from ..model.beam import Beam, Contactor
+from ..exceptions import ParameterError
 
 if TYPE_CHECKING:
     import xarray as xr
 
-    from .solver.solution import Event, ModalState, PiecewiseSolution
+    from ..solver.solution import Event, ModalState, PiecewiseSolution
 
 __all__ = [
     "SimulationResult", "write_result", "RESULT_SUFFIXES", "sample_count", "memory_limit", "check_memory", "output_bytes",
@@ -119,7 +119,7 @@ class SimulationResult:
         out = tuple(self.solution.warnings)
         conv = self.__dict__.get("_convergence")
         if conv is not None and not self.converged:
-            from .solver.convergence import worst
+            from ..solver.convergence import worst
 
             key, change = worst(conv)
             out += (
@@ -150,8 +150,8 @@ class SimulationResult:
         None when it cannot be computed (one mode).
         """
         if "_convergence" not in self.__dict__:
-            from ._warnings import emit_user_level_warning as warn
-            from .solver.convergence import coarser_count, relative_changes
+            from .._warnings import emit_user_level_warning as warn
+            from ..solver.convergence import coarser_count, relative_changes
 
             if self.rerun is None or self.n_modes <= 1:
                 return None
@@ -179,7 +179,7 @@ class SimulationResult:
 
     def _repr_html_(self) -> str:
         """Compact summary for Jupyter: run, contactors, metrics, warnings."""
-        from . import _html
+        from .. import _html
         from .metrics import METRIC_DISPLAY
 
         m = self.metrics(impacts=False)
@@ -367,7 +367,7 @@ class SimulationResult:
         times : float or array_like, [s]
             Times in ``[0, end_time]``.
         static_correction : bool
-            The mode-acceleration method (default); see :mod:`impactbeam.stress`.
+            The mode-acceleration method (default); see :mod:`impactbeam.result.stress`.
 
         Returns
         -------
@@ -405,7 +405,7 @@ class SimulationResult:
         ModalState
             At ``solution.t_end``, in the free state's basis. Only for the exact method.
         """
-        from .solver.solution import basis_signature
+        from ..solver.solution import basis_signature
 
         if not hasattr(self.solution, "modal_state"):
             raise ParameterError('final_state: only a run with method = "exact" has a modal state to continue from')
@@ -414,7 +414,7 @@ class SimulationResult:
 
     # ------------------------------------------------------------------ derived
     def metrics(self, *, impacts: bool = True) -> dict[str, Any]:
-        """Response metrics (keys of ``impactbeam simulate --json``); see :mod:`impactbeam.metrics`.
+        """Response metrics (keys of ``impactbeam simulate --json``); see :mod:`impactbeam.result.metrics`.
 
         Parameters
         ----------
@@ -442,7 +442,7 @@ class SimulationResult:
 
         Columns: ``contactor``, ``start`` [s], ``end`` [s], ``duration`` [s],
         ``peak_force`` [N], ``impulse`` [N s]; exact (closed form), see
-        :mod:`impactbeam.metrics`.
+        :mod:`impactbeam.result.metrics`.
         """
         import pandas as pd
 
@@ -461,7 +461,7 @@ class SimulationResult:
         paper), the scenario as TOML text (``scenario``), the metrics as JSON
         (``metrics``), the solver options, status, message and warnings.
         """
-        from ._dataset import result_dataset
+        from .dataset import result_dataset
 
         return result_dataset(self)
 
@@ -495,7 +495,7 @@ class SimulationResult:
         -------
         PlotHandles
         """
-        from .plot import plot_result
+        from ..plot.response import plot_result
 
         return plot_result(self, path, **kwargs)
 
@@ -524,7 +524,7 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     suffix = path.suffix.lower()
     if suffix not in RESULT_SUFFIXES:
         raise ParameterError(f"--out: unsupported file type {suffix!r}; use one of {', '.join(RESULT_SUFFIXES)}")
-    from ._optional import require
+    from .._optional import require
 
     require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
     path.parent.mkdir(parents=True, exist_ok=True)

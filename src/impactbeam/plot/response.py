@@ -1,4 +1,4 @@
-"""Matplotlib figures of simulation results, sized and styled for journals.
+"""Figures of one or several simulation results: the response, the excitation, the contact force.
 
 Every function takes an optional ``ax=`` (or ``axes=``), never touches the
 global pyplot state when it creates its own figure (a bare
@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from ._figure import PlotHandles, _finish, _new_figure, save_figure
-from ._plotstyle import (
+from .figure import PlotHandles, _finish, _new_figure, save_figure
+from .style import (
     _EXCITATION_AXIS,
     SERIES_STYLES,
     STYLE,
@@ -43,27 +43,14 @@ from ._plotstyle import (
     _styled,
     figure_size,
 )
-from .exceptions import ParameterError
+from ..exceptions import ParameterError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from ._typing import ResultLike
+    from ..result.protocol import ResultLike
 
-__all__ = [
-    "PlotHandles",
-    "plot_result",
-    "plot_response",
-    "plot_excitation",
-    "plot_parameter_study",
-    "plot_convergence",
-    "surface_distance",
-    "save_figure",
-    "figure_size",
-    "SERIES_STYLES",
-    "STYLE",
-    "rc_context",
-]
+__all__ = ["plot_result", "plot_response", "plot_excitation", "surface_distance"]
 
 _MM = 1e3
 _MS = 1e3
@@ -191,7 +178,7 @@ def plot_result(
         ``axes`` = (response[, force][, excitation]); ``artists`` holds
         ``contact_spans``, ``impacts``, ``rebounds``, ``surface``, ``legend``.
     """
-    from .metrics import contact_intervals
+    from ..result.metrics import contact_intervals
 
     if quantity not in ("u", "w", "both"):
         raise ParameterError(f'quantity: must be "u", "w" or "both", got {quantity!r}')
@@ -395,5 +382,3 @@ def plot_excitation(
     leg = _outside_legend(fig, ax) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
 
-
-from .studyplot import plot_convergence, plot_parameter_study  # noqa: E402  (re-exported: part of this module's API)

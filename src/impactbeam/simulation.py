@@ -1,0 +1,274 @@
+"""The simulation API: a scenario (or model objects) in, a :class:`~impactbeam.result.SimulationResult` out.
+
+:func:`simulate` checks what the model cannot represent, runs the exact
+solver of :mod:`impactbeam.solver` (or the independent ``solve_ivp``
+reference), and wraps the exact solution in a result; ``solver.modes =
+"auto"`` repeats that with more modes until the metrics settle. This module
+sits above the layers it joins (scenario, model, solver, result) and none of
+them imports it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import os
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from ._warnings import emit_user_level_warning as warn
+from .exceptions import ParameterError
+from .model import Damping, SolverOptions
+from .model.beam import Beam, Contactor
+from .model.loading import Excitation, InitialCondition
+from .result import SimulationResult
+from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
+from .solver.convergence import AUTO_COUNTS, relative_changes
+
+if TYPE_CHECKING:
+    from .scenario import Scenario
+
+__all__ = ["simulate", "simulate_system"]
+
+Method = Literal["exact", "ivp"]
+
+
+def simulate_system(
+    beam: Beam,
+    contactors: Sequence[Contactor] = (),
+    *,
+    damping: Damping | None = None,
+    excitation: Excitation | None = None,
+    initial: InitialCondition | None = None,
+    options: SolverOptions | None = None,
+    points: Sequence[float] | None = None,
+    method: Method = "exact",
+    progress: Callable[[float], None] | None = None,
+    name: str = "system",
+    start: ModalState | None = None,
+) -> SimulationResult:
+    """Simulate a beam given as objects rather than as a scenario; see :func:`simulate`.
+
+    Parameters
+    ----------
+    beam : Beam
+    contactors : sequence of Contactor
+    damping : Damping, optional
+        Default: undamped.
+    excitation : Excitation, optional
+        Default: none.
+    initial : InitialCondition, optional
+        Default: at rest.
+    options : SolverOptions, optional
+        Default settings when None.
+    points : sequence of float, optional, [m]
+        Output points; default: the contactors, then the right end.
+    method : {"exact", "ivp"}
+        As for :func:`simulate`.
+    progress : callable, optional
+        As for :func:`simulate`.
+    name : str
+        Name of the run (in result files).
+    start : ModalState, optional
+        As for :func:`simulate`.
+    """
+    damping = damping or Damping()
+    excitation = excitation or Excitation()
+    initial = initial or InitialCondition()
+    options = options or SolverOptions()
+    contactors = tuple(contactors)
+    for i, c in enumerate(contactors):
+        c.check_on(beam, f"contactors.{i}")
+        if np.isinf(c.stiffness):
+            k_ref = 3.0 * beam.bending_stiffness / beam.length**3
+            raise ParameterError(
+                f'contactors.{i}.stiffness: "inf" (a rigid stop) has contact-state modes (impactbeam modes) '
+                "but cannot be simulated: an impact on a rigid stop needs a restitution law the modal model "
+                f"does not have; give a finite stiffness (the stop's measured contact stiffness; for scale, "
+                f"3 E I / L^3 of this beam is {k_ref:.4g} N/m)"
+            )
+    if points is None:
+        pts = [c.position for c in contactors] + [beam.length]
+        points = list(dict.fromkeys(pts))
+    pts_arr = np.asarray(points, dtype=float)
+    if pts_arr.size == 0:
+        raise ParameterError("output.points: at least one output point is needed")
+    if np.any(pts_arr < 0) or np.any(pts_arr > beam.length * (1 + 1e-12)):
+        raise ParameterError(f"output.points: every point must lie on the beam [0, {beam.length:g}] m")
+    if excitation.kind == "point_force" and excitation.position is not None and excitation.position > beam.length * (1 + 1e-12):
+        raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
+    _check_distinct(contactors)
+    if method not in ("exact", "ivp"):
+        raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
+    _check_start(start, beam, contactors, options, method)
+
+    def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
+        opt = options if options.modes == n_modes else dataclasses.replace(options, modes=n_modes)
+        if method == "ivp":
+            from .solver.reference import integrate_ivp
+
+            solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt)
+        else:
+            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress,
+                                 None if start is None else (start.eta, start.deta))
+        if announce:
+            for text in solution.warnings:
+                warn(text)
+        info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method,
+                "basis": opt.basis}
+        return SimulationResult(solution, pts_arr, beam, contactors, n_modes, opt.time_step, opt.end_time, name,
+                                info, rerun=functools.partial(run, announce=False), tolerance=opt.tolerance)
+
+    if options.modes != "auto":
+        return run(int(options.modes))
+    return _auto_modes(run, options.tolerance)
+
+
+def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contactor, ...],
+                 options: SolverOptions, method: str) -> None:
+    """ParameterError unless ``start`` is a state of this model's free-state basis."""
+    if start is None:
+        return
+    if not isinstance(start, ModalState):
+        raise ParameterError(f"start: expected a ModalState (result.final_state()), got {type(start).__name__}")
+    if method != "exact" or options.modes == "auto":
+        raise ParameterError('start: a run from a modal state needs method = "exact" and a fixed solver.modes')
+    if start.basis != basis_signature(beam, contactors, int(options.modes), options.basis):
+        raise ParameterError(
+            "start: the state belongs to another modal basis (beam, contactor positions, solver.modes or "
+            "solver.basis differ); start from rest or from a state of this model"
+        )
+
+
+def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> SimulationResult:
+    """``solver.modes = "auto"``: add modes until the metrics change by less than ``tolerance``."""
+    prev = None
+    for n in AUTO_COUNTS:
+        res = run(n, announce=False)
+        m = res.metrics(impacts=False)
+        if prev is not None:
+            changes = relative_changes(m, prev)
+            res.set_convergence(changes)
+            if max(changes.values()) < tolerance:
+                break
+        prev = m
+    for text in res.warnings:
+        warn(text)
+    return res
+
+
+def _check_distinct(contactors: tuple[Contactor, ...]) -> None:
+    """Refuse two contactors at one point on one side with one gap: they would switch endlessly."""
+    seen: dict[tuple[float, str, float], int] = {}
+    for i, c in enumerate(contactors):
+        key = (c.position, c.side, c.gap)
+        if key in seen:
+            j = seen[key]
+            raise ParameterError(
+                f"contactors.{i}: same position, side and gap as contactors.{j}; use one contactor of stiffness "
+                f"{contactors[j].stiffness:g} + {c.stiffness:g} N/m instead"
+            )
+        seen[key] = i
+
+
+def _require_scenario(scenario: object) -> None:
+    """TypeError for anything but a Scenario (a path, a dict), saying what to do."""
+    from .scenario import Scenario
+
+    if isinstance(scenario, Scenario):
+        return
+    if isinstance(scenario, (str, os.PathLike)):
+        raise TypeError(
+            f"simulate: got the path {str(scenario)!r}; read it first: "
+            "impactbeam.simulate(impactbeam.load_scenario(path))"
+        )
+    raise TypeError(
+        f"simulate: expected a Scenario (from impactbeam.load_scenario or parse_scenario), got "
+        f"{type(scenario).__name__}; for a beam given as objects use impactbeam.simulate_system"
+    )
+
+
+def simulate(
+    scenario: Scenario,
+    *,
+    method: Method = "exact",
+    progress: Callable[[float], None] | None = None,
+    start: ModalState | None = None,
+) -> SimulationResult:
+    """Transient response of the scenario's beam (paper section 2, eqs. 9-12).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        From :func:`impactbeam.load_scenario`.
+    method : {"exact", "ivp"}
+        ``"exact"``: closed-form integration between exactly located events.
+        ``"ivp"``: the same modal equations by :func:`scipy.integrate.solve_ivp`
+        with events (a slower independent reference used by the tests).
+    progress : callable, optional
+        Called with the current simulated time as the run advances.
+    start : ModalState, optional
+        Begin at t = 0 from this state (``previous_result.final_state()``)
+        instead of ``[initial]``: a run continued from the end of another of
+        the same model (same beam, contactor positions, modes and basis).
+
+    Returns
+    -------
+    SimulationResult
+
+    Raises
+    ------
+    TypeError
+        When ``scenario`` is not a Scenario (e.g. a file path).
+    ParameterError
+        For a rigid contactor (``stiffness = inf``): give a finite stiffness.
+
+    Notes
+    -----
+    The solution is exact for the truncated N-mode model: between events
+    every mode is integrated in closed form for the half-sine pulse, the step,
+    and tables held constant or linear between samples, for any damping ratio
+    (including 0, critical and over-damped) and for rigid-body modes.
+    The remaining errors are modal truncation (``solver.modes``) and the event
+    time tolerance (``solver.event_tolerance``, 1e-13 s by default). With
+    ``solver.basis = "enriched"`` (default) all states share one Ritz basis
+    (the free modes plus a static attachment shape per contactor,
+    :mod:`~impactbeam.solver.ritz`) and a switch is exact; with ``"paper"``
+    each state has its own exact modes and a switch is the projection of
+    paper eq. (12), an L2 projection of the displacement and velocity onto N
+    modes, lossy for contactors much stiffer than the retained modes.
+
+    Events are located on the closed form, independently of the output
+    step: the scan advances by steps that a bound on the second derivative of
+    each contactor's opening (from the modal amplitudes and frequencies)
+    proves free of any crossing, subdivides a step that it cannot prove, and
+    refines a proven single crossing by Brent's method to
+    ``solver.event_tolerance``. A dip into a stop deeper than 1e-12 of the
+    beam length cannot be missed; a tangency at the start of a segment (zero
+    gap at rest, a contactor just switched) is decided by the first
+    derivative of the opening that is not zero up to round-off. The output
+    samples (``result.time``) are evaluated from the exact solution only when
+    asked for, and the metrics come from the exact solution (extrema by
+    branch and bound on the closed form, impulses in closed form).
+
+    Warnings the solver raises (:class:`~impactbeam.exceptions.ImpactBeamWarning`)
+    are also listed in ``result.warnings``.
+    """
+    _require_scenario(scenario)
+    res = simulate_system(
+        scenario.beam,
+        scenario.contactors,
+        damping=scenario.damping,
+        excitation=scenario.excitation,
+        initial=scenario.initial,
+        options=scenario.solver,
+        points=scenario.output_points,
+        method=method,
+        progress=progress,
+        name=scenario.name,
+        start=start,
+    )
+    object.__setattr__(res, "scenario", scenario)
+    return res
