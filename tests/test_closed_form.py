@@ -72,7 +72,7 @@ class _Segment:
     """One segment of the compiled closed form (setup once, evaluate anywhere)."""
 
     def __init__(self, omegas, xis, load, eta0, deta0):
-        dyn = ModalDynamics(np.asarray(omegas, float), np.asarray(xis, float))
+        dyn = ModalDynamics(np.asarray(omegas, float), np.asarray(xis, float) * np.asarray(omegas, float))
         n = len(omegas)
         a, b, d, Om, phi = load
         self.reg = np.where(dyn.under, 0, np.where(dyn.over, 2, 1)).astype(np.int64)

@@ -67,6 +67,8 @@ DIMENSIONS: dict[str, _Dimension] = {
     "frequency": _Dimension("Hz", "Hz", "a frequency"),
     "angle": _Dimension("rad", "rad", "an angle"),
     "rotary_inertia": _Dimension("kg m^2", "kg*m^2", "a rotary inertia"),
+    "damping_coefficient": _Dimension("N s/m", "N*s/m", "a damping coefficient"),
+    "rate": _Dimension("1/s", "1/s", "a rate (per second)"),
     "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
 }
 
@@ -81,6 +83,7 @@ _KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
     ("m^3", "a volume"),
     ("m^4", "a second moment of area"),
     ("m/s", "a velocity"),
+    ("N*s/m", "a damping coefficient"),
     ("m/s^2", "an acceleration"),
     ("N", "a force"),
     ("N/m", "a stiffness or force per length"),

@@ -412,12 +412,24 @@ class Contactor:
         Clearance ``c`` >= 0 between the beam at rest and the contactor surface.
     side : {"below", "above"}
         ``below`` resists ``w(a) < -gap``; ``above`` resists ``w(a) > gap``.
+    damping : float, [N s/m]
+        Dashpot ``c`` in parallel with the spring (code_aster's ``AMOR_NOR``):
+        with the penetration ``d``, the force is ``k d + c d'`` while ``d > 0``
+        and that force is positive, else 0; it never pulls, so the contact ends
+        when the force reaches 0 (before ``d`` returns to 0).
+    restitution : float, optional
+        A coefficient of restitution ``0 < e <= 1`` instead of ``damping``: the
+        dashpot that gives the engaged state's contact mode the damping ratio
+        of a spring-dashpot impact with restitution ``e``
+        (:func:`impactbeam.solver.damping.restitution_ratio`); ``e = 1`` is no dashpot.
     """
 
     position: float
     stiffness: float
     gap: float = 0.0
     side: Side = "below"
+    damping: float = 0.0
+    restitution: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", nonnegative_finite("contactor.position", self.position))
@@ -427,6 +439,19 @@ class Contactor:
         object.__setattr__(self, "stiffness", k)
         object.__setattr__(self, "gap", nonnegative_finite("contactor.gap", self.gap))
         choice("contactor.side", self.side, ("below", "above"))
+        object.__setattr__(self, "damping", nonnegative_finite("contactor.damping", self.damping))
+        if self.restitution is not None:
+            e = float(self.restitution)
+            if not (0.0 < e <= 1.0):
+                raise ParameterError(f"contactor.restitution: must be in (0, 1] (1: no loss), got {self.restitution!r}")
+            if self.damping:
+                raise ParameterError("contactor.restitution: give damping or restitution, not both")
+            object.__setattr__(self, "restitution", e)
+
+    @property
+    def dissipative(self) -> bool:
+        """True when the contactor has a dashpot (``damping > 0`` or ``restitution < 1``)."""
+        return self.damping > 0.0 or (self.restitution is not None and self.restitution < 1.0)
 
     @property
     def rigid(self) -> bool:

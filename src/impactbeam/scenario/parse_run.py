@@ -10,6 +10,7 @@ from ..model.beam import Beam, Contactor
 from ..exceptions import ScenarioError
 from ..model.loading import Excitation, InitialCondition
 from ..model import BASES, Damping, SolverOptions
+from ..model.damping import DAMPING_MODELS, MODEL_KEYS
 from ..units import describe_dimension, to_si
 from .fields import (
     _choice,
@@ -44,8 +45,18 @@ def _ratios(table: Mapping[str, Any], name: str) -> float | tuple[float, ...]:
 
 def _parse_damping(raw: Mapping[str, Any]) -> Damping:
     d = raw.get("damping", {})
+    model = _choice("damping.model", d.get("model", "modal"), DAMPING_MODELS)
+    used = MODEL_KEYS[model]
+    for key in d:
+        if key != "model" and key not in used:
+            raise ScenarioError(
+                f'damping.{key}: not used by damping.model = "{model}" (which reads {" and ".join(used)})',
+                key=f"damping.{key}",
+            )
+    alpha = _nonnegative("damping.alpha", d.get("alpha", 0.0), "rate")
+    beta = _nonnegative("damping.beta", d.get("beta", 0.0), "time")
     with _relabel("damping"):
-        return Damping(_ratios(d, "free"), _ratios(d, "contact"))
+        return Damping(_ratios(d, "free"), _ratios(d, "contact"), model, alpha, beta)  # type: ignore[arg-type]
 
 
 def _reject_unused(table: Mapping[str, Any], names: tuple[str, ...], why: str) -> None:

@@ -210,6 +210,10 @@ def _parse_contactors(raw: Mapping[str, Any], beam: Beam) -> tuple[Contactor, ..
         stiffness = _contact_stiffness(c, prefix)
         gap = _nonnegative(f"{prefix}.gap", c.get("gap", 0.0), "length")
         side = _choice(f"{prefix}.side", c.get("side", "below"), _SIDES)
+        damping = _nonnegative(f"{prefix}.damping", c.get("damping", 0.0), "damping_coefficient")
+        restitution = None
+        if "restitution" in c:
+            restitution = to_si(c["restitution"], "dimensionless", f"{prefix}.restitution")
         with _relabel(prefix, (("contactor.", f"{prefix}."),)):
-            out.append(Contactor(position, stiffness, gap, side))  # type: ignore[arg-type]
+            out.append(Contactor(position, stiffness, gap, side, damping, restitution))  # type: ignore[arg-type]
     return tuple(out)

@@ -91,10 +91,14 @@ _SCHEMA = _Table(
             "sections": _Array(_Table(_values(**_SECTION))),
         }),
         "supports": _Table({"left": _SUPPORT_NODE, "right": _SUPPORT_NODE}),
-        "contactors": _Array(_Table(_values(**_POSITION, stiffness="stiffness", gap="length", side=None))),
+        "contactors": _Array(_Table(_values(**_POSITION, stiffness="stiffness", gap="length", side=None,
+                                             damping="damping_coefficient", restitution="dimensionless"))),
         "masses": _Array(_Table(_values(**_POSITION, mass="mass", rotary_inertia="rotary_inertia"))),
         "springs": _Array(_Table(_values(**_POSITION, **_SPRINGS))),
-        "damping": _Table(_values(free="dimensionless", contact="dimensionless", list_ok=True)),
+        "damping": _Table({
+            **_values(free="dimensionless", contact="dimensionless", list_ok=True),
+            **_values(model=None, alpha="rate", beta="time"),
+        }),
         "excitation": _Table(
             _values(
                 kind=None, shape=None, amplitude=AMPLITUDE, duration="time", start="time", **_POSITION,

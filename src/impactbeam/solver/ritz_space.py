@@ -171,7 +171,7 @@ class RitzStateSpace(ProblemSpace):
             omega, Phi = _state_eigen(self.basis, springs, self._psi_c)
             ms = RitzModes(self.basis, Phi, omega)
             n = ms.count
-            dyn = ModalDynamics(omega, self.damping.ratios(bool(engaged), n))
+            dyn = ModalDynamics(omega, self.damping.decay_rates(bool(engaged), omega))
             Wc = np.ascontiguousarray((Phi.T @ self._psi_c).T) if self.contactors else np.zeros((0, n))
             Wo = np.ascontiguousarray((Phi.T @ self._psi_o).T) if self.points.size else np.zeros((0, n))
             p = Phi.T @ self._p

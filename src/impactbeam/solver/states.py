@@ -21,23 +21,20 @@ __all__ = ["ModalDynamics", "StateModel", "StateSpace"]
 
 @dataclass(frozen=True, eq=False)
 class ModalDynamics:
-    """Frequencies and damping of the modes of one state, with regime masks.
+    """Frequencies and decay rates of the modes of one state, with regime masks.
 
-    ``decay = xi omega``; a mode is under-damped (``wd = omega sqrt(1 - xi^2)``),
-    over-damped (``wh = omega sqrt(xi^2 - 1)``) or critical, rigid-body modes
-    (``omega = 0``) counting as critical with zero decay.
+    ``decay = xi omega`` [1/s]; a mode is under-damped (``wd = sqrt(omega^2 -
+    decay^2)``), over-damped (``wh = sqrt(decay^2 - omega^2)``) or critical;
+    an undamped rigid-body mode (``omega = decay = 0``) counts as critical, a
+    damped one (Rayleigh's ``alpha``) as over-damped.
     """
 
     omega: np.ndarray
-    xi: np.ndarray
-
-    @property
-    def decay(self) -> np.ndarray:
-        return self.xi * self.omega
+    decay: np.ndarray
 
     @property
     def _disc(self) -> np.ndarray:
-        return self.omega**2 * (1.0 - self.xi**2)
+        return self.omega**2 - self.decay**2
 
     @property
     def under(self) -> np.ndarray:
@@ -155,8 +152,7 @@ class StateSpace(ProblemSpace):
     def _build(self, engaged: tuple[int, ...]) -> StateModel:
         springs = [(self.contactors[i].position, self.contactors[i].stiffness) for i in engaged]
         ms = mode_set(self.beam, springs, self.n_modes)
-        xi = self.damping.ratios(bool(engaged), ms.count)
-        dyn = ModalDynamics(ms.omega, xi)
+        dyn = ModalDynamics(ms.omega, self.damping.decay_rates(bool(engaged), ms.omega))
         n = ms.count
         Wc = np.ascontiguousarray(ms.shapes(self.positions).T) if self.contactors else np.zeros((0, n))
         Wo = np.ascontiguousarray(ms.shapes(self.points).T) if self.points.size else np.zeros((0, n))
