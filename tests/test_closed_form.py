@@ -25,6 +25,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from impactbeam.solver import _closed
+from impactbeam.solver._dense import _row3
+from impactbeam.solver._events import row_at
 from impactbeam.solver.states import ModalDynamics
 
 REL_TOL = 1e-9
@@ -71,19 +73,35 @@ def _reference(omega, xi, load, eta0, deta0, taus):
 class _Segment:
     """One segment of the compiled closed form (setup once, evaluate anywhere)."""
 
-    def __init__(self, omegas, xis, load, eta0, deta0):
-        dyn = ModalDynamics(np.asarray(omegas, float), np.asarray(xis, float) * np.asarray(omegas, float))
+    def __init__(self, omegas, xis, load, eta0, deta0, decays=None, cosine=0.0):
+        omegas = np.asarray(omegas, float)
+        decay = np.asarray(xis, float) * omegas if decays is None else np.asarray(decays, float)
+        dyn = ModalDynamics(omegas, decay)
         n = len(omegas)
         a, b, d, Om, phi = load
         self.reg = np.where(dyn.under, 0, np.where(dyn.over, 2, 1)).astype(np.int64)
         self.a = dyn.decay
         self.w = np.where(dyn.under, dyn.wd, dyn.wh)
         self.om = dyn.omega
-        self.load = (np.full(n, a), np.full(n, b or 0.0), np.full(n, d or 0.0))
+        self.load = (np.full(n, a), np.full(n, b or 0.0), np.full(n, d or 0.0), np.full(n, cosine))
         self.Om, self.phi = Om, phi
         self.eta0, self.deta0 = np.asarray(eta0, float), np.asarray(deta0, float)
-        self.h0, self.dh0, self.P = np.empty(n), np.empty(n), np.empty((n, 7))
+        self.h0, self.dh0, self.P = np.empty(n), np.empty(n), np.empty((n, _closed.NP))
         _closed.setup(self.reg, self.a, self.om, *self.load, Om, phi, self.eta0, self.deta0, self.h0, self.dh0, self.P)
+
+    def project(self, v, u=None, alpha=(0.0, 0.0, 0.0)):
+        """Row ``v . z + u . (z' - alpha)`` as (VH, VD, PV), one row."""
+        n = self.om.size
+        u = np.zeros(n) if u is None else np.asarray(u, float)
+        AL = np.tile(np.asarray(alpha, float), (n, 1))
+        VH, VD, PV = np.empty((1, n)), np.empty((1, n)), np.empty((1, _closed.NP))
+        _closed.project(np.asarray(v, float)[None], u[None], np.zeros(1), self.a, self.om, self.h0, self.dh0,
+                        self.P, AL, self.Om, VH, VD, PV, 1)
+        return VH, VD, PV
+
+    def integral(self, v, T):
+        VH, VD, PV = self.project(v)
+        return _closed.integral_of(VH, VD, PV, self.reg, self.a, self.w, self.om, self.Om, self.phi, T)
 
     def evaluate(self, taus):
         n = self.om.size
@@ -201,7 +219,8 @@ def test_derivatives_are_those_of_the_closed_form():
     seg = _Segment([7.0, 0.0, 3.0], [0.05, 0.0, 1.5], LOADS["all"], [0.3, 0.1, -0.2], [0.2, -0.4, 0.6])
     v = np.array([0.7, -1.1, 0.4])
     out, mag = np.empty(4), np.empty(4)
-    _closed.derivatives(v, 0.25, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, seg.Om, seg.phi, 3, out, mag)
+    _closed.derivatives(v, np.zeros(3), 0.25, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, np.zeros((3, 3)),
+                        seg.Om, seg.phi, 3, out, mag)
     h = 1e-3
     taus = np.array([0.0, h, 2 * h, 3 * h, 4 * h])
     eta, deta = seg.evaluate(taus)
@@ -225,7 +244,7 @@ def test_integral_in_closed_form_matches_quadrature(load_name):
                    np.linspace(-0.7, 0.9, len(REGIMES)), np.linspace(1.1, -0.4, len(REGIMES)))
     v = np.linspace(0.5, -1.5, len(REGIMES))
     T = 2.3
-    exact = _closed.integral_of(v, seg.reg, seg.a, seg.w, seg.om, seg.h0, seg.dh0, seg.P, seg.Om, seg.phi, T)
+    exact = seg.integral(v, T)
     x, w = np.polynomial.legendre.leggauss(460)
     taus = 0.5 * T * (x + 1)
     eta, _ = seg.evaluate(taus)
@@ -237,8 +256,82 @@ def test_exact_resonance_integral():
     # the resonant tau cos(theta) term has its own antiderivative
     seg = _Segment([7.0], [0.0], (0.0, None, 2.0, 7.0, 0.3), [0.1], [0.0])
     T = 3.0
-    exact = _closed.integral_of(np.ones(1), seg.reg, seg.a, seg.w, seg.om, seg.h0, seg.dh0, seg.P, seg.Om,
-                                seg.phi, T)
+    exact = seg.integral(np.ones(1), T)
     x, w = np.polynomial.legendre.leggauss(400)
     eta, _ = seg.evaluate(0.5 * T * (x + 1))
     assert exact == pytest.approx(0.5 * T * float(eta[0] @ w), rel=1e-12)
+
+
+# --------------------------------------------------------------------------- the generalised closed form
+# (states whose modes do not diagonalise their damping: cosine loads, rows on z and z', damped rigid modes)
+
+def _reference_general(omega, decay, load, cosine, eta0, deta0, taus):
+    a, b, d, Om, phi = load
+    b = b or 0.0
+    d = d or 0.0
+
+    def rhs(t, y):
+        f = a + b * t + d * math.sin(Om * t + phi) + cosine * math.cos(Om * t + phi)
+        return [y[1], f - 2 * decay * y[1] - omega**2 * y[0]]
+
+    sol = solve_ivp(rhs, (0.0, taus[-1]), [eta0, deta0], method="DOP853", rtol=1e-12,
+                    atol=1e-15 * max(abs(eta0), abs(deta0), 1.0), t_eval=taus)
+    assert sol.success
+    return sol.y[0], sol.y[1]
+
+
+@pytest.mark.parametrize("omega,decay", [(7.0, 0.0), (7.0, 0.3), (7.0, 7.0), (7.0, 12.0), (0.0, 0.8), (0.0, 0.0)])
+def test_cosine_loads_and_damped_rigid_coordinates(omega, decay):
+    # A cosine term (the rate of a load acting on a block's first equation) and a
+    # rigid-body coordinate with damping (Rayleigh's alpha, z'' + 2a z' = f): the
+    # closed form against DOP853 (tolerance as for every regime above).
+    load, cosine = LOADS["all"], 0.9
+    taus = np.linspace(0.0, 3.0, 121)
+    seg = _Segment([omega], [0.0], load, [0.4], [-0.3], decays=[decay], cosine=cosine)
+    eta, deta = seg.evaluate(taus)
+    ref, dref = _reference_general(omega, decay, load, cosine, 0.4, -0.3, taus)
+    assert np.abs(eta[0] - ref).max() <= REL_TOL * np.abs(ref).max()
+    assert np.abs(deta[0] - dref).max() <= REL_TOL * np.abs(dref).max()
+
+
+def test_rows_on_rates_project_exactly():
+    # A row v z + u (z' - alpha(tau)) written as (VH, VD, PV) evaluates to the same
+    # function as the closed form itself (values and slopes, every regime; alpha a
+    # load-shaped function), and its integral and derivatives follow.
+    omegas = [o for o, _ in REGIMES] + [0.0]
+    xis = [x for _, x in REGIMES] + [0.0]
+    decays = np.asarray(xis) * np.asarray(omegas)
+    decays[-1] = 0.6  # a damped rigid-body coordinate
+    n = len(omegas)
+    seg = _Segment(omegas, xis, LOADS["all"], np.linspace(-0.7, 0.9, n), np.linspace(1.1, -0.4, n), decays=decays,
+                   cosine=0.35)
+    v, u = np.linspace(0.5, -1.5, n), np.linspace(-0.3, 0.8, n)
+    alpha = (0.2, -0.1, 0.45)
+    VH, VD, PV = seg.project(v, u, alpha)
+    taus = np.linspace(0.0, 2.3, 47)
+    eta, deta = seg.evaluate(taus)
+    _, Om, phi = LOADS["all"][2], seg.Om, seg.phi
+    al = alpha[0] + alpha[1] * taus + alpha[2] * np.sin(Om * taus + phi)
+    direct = v @ eta + u @ (deta - al[None, :])
+    rows = np.array([row_at(0, t, seg.reg, seg.a, seg.w, seg.om, VH, VD, np.zeros(1), PV, Om, phi)[0] for t in taus])
+    assert np.abs(rows - direct).max() <= 1e-12 * np.abs(direct).max()
+    T = 2.3
+    exact = _closed.integral_of(VH, VD, PV, seg.reg, seg.a, seg.w, seg.om, Om, phi, T)
+    x, w = np.polynomial.legendre.leggauss(460)
+    tq = 0.5 * T * (x + 1)
+    e, d = seg.evaluate(tq)
+    alq = alpha[0] + alpha[1] * tq + alpha[2] * np.sin(Om * tq + phi)
+    quad = 0.5 * T * float((v @ e + u @ (d - alq[None, :])) @ w)
+    assert exact == pytest.approx(quad, rel=1e-12, abs=1e-13)
+    out, mag = np.empty(4), np.empty(4)
+    AL = np.tile(np.asarray(alpha), (n, 1))
+    _closed.derivatives(v, u, 0.0, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, AL, Om, phi, 3, out, mag)
+    assert out[0] == pytest.approx(direct[0], rel=1e-13)
+    # the second derivative from the equation of motion against the one from the kernels (another formula)
+    _, d1, d2 = _row3(0.0, seg.reg, seg.a, seg.w, seg.om, VH, VD, np.zeros(1), PV, Om, phi)
+    assert out[1] == pytest.approx(d1, rel=1e-12)
+    assert out[2] == pytest.approx(d2, rel=1e-12)
+    # and a finite difference of the slope: h = 1e-4, truncation h^2 f^(4) / 3, 1e-5 relative (fast root 34/s)
+    h = 1e-4
+    g1 = [row_at(0, t, seg.reg, seg.a, seg.w, seg.om, VH, VD, np.zeros(1), PV, Om, phi)[1] for t in (0.0, h, 2 * h)]
+    assert out[2] == pytest.approx((-3 * g1[0] + 4 * g1[1] - g1[2]) / (2 * h), rel=1e-4)

@@ -100,7 +100,6 @@ def simulate_system(
     if excitation.kind == "point_force" and excitation.position is not None and excitation.position > beam.length * (1 + 1e-12):
         raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
     _check_distinct(contactors)
-    _check_supported(contactors, damping)
     if method not in ("exact", "ivp"):
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
     _check_start(start, beam, contactors, options, method)
@@ -158,15 +157,6 @@ def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> Simul
     for text in res.warnings:
         warn(text)
     return res
-
-
-def _check_supported(contactors: tuple[Contactor, ...], damping: Damping) -> None:
-    """Refuse the dissipation models the engine does not integrate yet (never ignore them)."""
-    for i, c in enumerate(contactors):
-        if c.dissipative:
-            raise ParameterError(f"contactors.{i}.damping: contactor dashpots are not supported by this version")
-    if damping.model == "free_modes":
-        raise ParameterError('damping.model: "free_modes" is not supported by this version')
 
 
 def _check_distinct(contactors: tuple[Contactor, ...]) -> None:

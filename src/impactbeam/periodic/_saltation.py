@@ -37,6 +37,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..exceptions import ParameterError
+
 __all__ = ["FlowJacobian", "flow_jacobian", "segment_transition", "to_free", "from_free", "GRAZING"]
 
 #: An event whose normal velocity is below this fraction of the orbit's velocity scale is grazing:
@@ -131,7 +133,7 @@ class _Field:
         pk = self.pk
         tau = t - self.pt0[kp]
         u = self.pconst[kp] + self.pslope[kp] * tau + self.pamp[kp] * math.sin(self.pOm[kp] * tau + self.pphase[kp])
-        F = pk.pw[s] * u
+        F = pk.pw[s] * u + pk.pre[s]
         mask = int(pk.smask[s])
         for c in range(self.gap.size):
             if (mask >> c) & 1 and self.gap[c] != 0.0:
@@ -153,10 +155,11 @@ class _Field:
         s, kp = int(sol.slot[j]), int(sol.piece[j])
         eta = np.array(sol.eta0[j], dtype=float)
         deta = np.array(sol.deta0[j], dtype=float)
-        h0, dh0, P, lA, lB, lD = workspace(pk.n_modes)
-        Om, phi = segment_setup(s, kp, float(sol.t0[j]), eta, deta, pk.reg, pk.dec, pk.om, pk.pw, pk.Wc, pk.smask,
-                                self.gap, self.side, self.kst, self.pt0, self.pconst, self.pslope, self.pamp,
-                                self.pOm, self.pphase, h0, dh0, P, lA, lB, lD)
+        h0, dh0, P, lA, lB, lD, lE, AL = workspace(pk.n_modes)
+        Om, phi = segment_setup(s, kp, float(sol.t0[j]), eta, deta, pk.reg, pk.dec, pk.om, pk.LW[:, 0], pk.LW[:, 1],
+                                pk.CW[:, 0], pk.CW[:, 1], pk.LW[:, 2], pk.LW[:, 3], pk.smask, self.gap, self.side,
+                                self.kst, self.pt0, self.pconst, self.pslope, self.pamp, self.pOm, self.pphase,
+                                h0, dh0, P, lA, lB, lD, lE, AL)
         e = np.empty(pk.n_modes)
         d = np.empty(pk.n_modes)
         state_at(float(sol.t1[j] - sol.t0[j]), pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], h0, dh0, P, Om, phi, e, d)
@@ -206,6 +209,11 @@ def flow_jacobian(sol) -> FlowJacobian:
     """
     pk = sol.packed
     n = pk.n_modes
+    if pk.general or np.any(pk.dash > 0.0):
+        raise ParameterError(
+            "periodic orbits by shooting need states whose modes diagonalise their damping: contactor dashpots "
+            '(contactors.N.damping, restitution) and damping.model = "free_modes" are not supported there'
+        )
     fld = _Field(sol)
     nseg = sol.n_segments
     if nseg == 0:

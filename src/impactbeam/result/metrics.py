@@ -12,14 +12,18 @@ point without contactor), so that ``u`` is positive away from the contactor:
 * ``n_impacts``: contact intervals begun; ``first_impact_time``: the first one's start;
 * ``energy_residual``: the energy balance residual of the N-mode solution,
   ``total(0) + input work - dissipated - total(end)``, which within segments
-  is zero exactly, so it is minus the sum of the energy changes at the switches.
+  is zero exactly, so it is minus the sum of the energy changes at the
+  switches, less what the contactors' dashpots dissipate at a release
+  (:meth:`~impactbeam.solver.solution.PiecewiseSolution.release_losses`).
 
 Every extremum is the maximum of the exact N-mode solution (branch and bound
 on the closed form, :mod:`impactbeam.solver._dense`), to 1e-12 of the beam
 length, and impulses are integrals in closed form: nothing depends on the
 output time step.
 
-Per impact (``impacts``): contactor, start, end, duration, peak force and impulse.
+Per impact (``impacts``): contactor, start, end, duration, peak force and
+impulse of the contact force ``k d + c d'`` (``d`` the compression, ``c`` the
+contactor's dashpot).
 """
 
 from __future__ import annotations
@@ -170,7 +174,7 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     out["max_response"] = float(ext[0, 0])
     t_max = float(ext[0, 1])
     out["t_max"] = t_max
-    out["energy_residual"] = -float(np.sum(result.energy_jumps))
+    out["energy_residual"] = -float(np.sum(result.energy_jumps)) - float(np.sum(sol.release_losses()[1]))
     if not result.contactors:
         out["min_response"] = -float(ext[1, 0])
     else:
@@ -234,16 +238,36 @@ def _peak_query(result: ResultLike, ci: int, a: float, be: float) -> tuple:
 def _impact_table(result: ResultLike, rows: list, peaks) -> list[dict[str, Any]]:
     """Duration, peak force and impulse of every contact interval (exact, closed form).
 
-    The compression of contactor ``c`` is ``-g = s w(a) - gap``; the peak force
-    is ``k`` times its maximum over the interval and the impulse ``k`` times
-    its integral.
+    The compression of contactor ``c`` is ``d = s w(a) - gap``; the force is
+    ``k d + c_d d'`` (``c_d`` its dashpot, 0 without). The peak force is the
+    maximum of that force over the interval and the impulse its integral,
+    ``k int d dt + c_d [d]``.
     """
     if not rows:
         return []
-    ints = result.solution.integrals([(result.contactors[ci].position, a, be) for ci, a, _, be in rows])
+    sol = result.solution
+    dash = getattr(sol, "dashpots", np.zeros(len(result.contactors)))
+    ints = sol.integrals([(result.contactors[ci].position, a, be) for ci, a, _, be in rows])
+    forced = [i for i, row in enumerate(rows) if dash[row[0]] > 0.0]
+    force_peaks = np.asarray(peaks, dtype=float).copy()
+    ends = {}
+    if forced:
+        fq = []
+        for i in forced:
+            ci, a, _, be = rows[i]
+            fq.append(_peak_query(result, ci, a, be) + (dash[ci] / result.contactors[ci].stiffness,))
+        force_peaks[forced] = sol.extrema(fq)[:, 0]
+        for i in forced:
+            ci, a, _, be = rows[i]
+            c = result.contactors[ci]
+            w = sol.sample(np.array([c.position]), np.array([a, be])).w[:, 0]
+            ends[i] = c.direction * w - c.gap  # the penetration at the start and at the end
     out = []
-    for (ci, a, b, be), peak, iw in zip(rows, peaks, ints):
+    for i, ((ci, a, b, be), peak, iw) in enumerate(zip(rows, force_peaks, ints)):
         c = result.contactors[ci]
+        impulse = c.stiffness * (c.direction * float(iw) - c.gap * (be - a))
+        if i in ends:
+            impulse += dash[ci] * float(ends[i][1] - ends[i][0])
         out.append(
             {
                 "contactor": ci,
@@ -251,7 +275,7 @@ def _impact_table(result: ResultLike, rows: list, peaks) -> list[dict[str, Any]]
                 "end": b if math.isfinite(b) else None,
                 "duration": (b - a) if math.isfinite(b) else None,
                 "peak_force": c.stiffness * max(float(peak), 0.0),
-                "impulse": c.stiffness * (c.direction * float(iw) - c.gap * (be - a)),
+                "impulse": impulse,
             }
         )
     out.sort(key=lambda d: (d["start"], d["contactor"]))

@@ -211,7 +211,7 @@ class SimulationResult:
             "engaged": np.empty((t.size, len(self.contactors)), dtype=bool),
         }
         if modal:
-            out.update(eta=np.empty((t.size, nm)), eta_t=np.empty((t.size, nm)), energies=np.empty((t.size, 4)))
+            out.update(eta=np.empty((t.size, nm)), eta_t=np.empty((t.size, nm)), energies=np.empty((t.size, 5)))
         for a in range(0, t.size, _CHUNK):
             b = min(a + _CHUNK, t.size)
             s = self.solution.sample(xs, t[a:b], modal=modal, energy=modal)
@@ -255,9 +255,13 @@ class SimulationResult:
     @functools.cached_property
     def contact_force(self) -> np.ndarray:
         force = np.zeros((self.time.size, len(self.contactors)))
+        dash = self.solution.dashpots
         for i, c in enumerate(self.contactors):
             g = c.gap - c.direction * self.w_contact[:, i]
-            force[:, i] = np.where(self.engaged[:, i], c.stiffness * np.maximum(-g, 0.0), 0.0)
+            f = c.stiffness * -g
+            if dash[i] > 0.0:
+                f = f + dash[i] * c.direction * self.w_t_contact[:, i]
+            force[:, i] = np.where(self.engaged[:, i], np.maximum(f, 0.0), 0.0)
         force[np.isnan(self.w_contact).any(axis=1)] = np.nan
         return force
 
@@ -272,7 +276,7 @@ class SimulationResult:
     @functools.cached_property
     def energy(self) -> dict[str, np.ndarray]:
         en = self._modal_grid["energies"]
-        kinetic, modal_strain, load_power, damping_power = en.T
+        kinetic, modal_strain, load_power, damping_power, dashpot_power = en.T
         contactor_energy = np.zeros(self.time.size)
         spring_at_zero_gap = np.zeros(self.time.size)
         for i, c in enumerate(self.contactors):
@@ -290,9 +294,14 @@ class SimulationResult:
 
         input_work = cumulative(load_power)
         dissipated = cumulative(damping_power)
+        t_rel, lost = self.solution.release_losses()
+        at_release = np.cumsum(np.bincount(np.searchsorted(self.time, t_rel, side="left"), weights=lost,
+                                           minlength=self.time.size + 1)[: self.time.size])
+        dashpots = cumulative(dashpot_power) + at_release
         return {
             "kinetic": kinetic, "strain": strain, "contactor": contactor_energy, "input_work": input_work,
-            "dissipated": dissipated, "total": total, "residual": total[0] + input_work - dissipated - total,
+            "dissipated": dissipated, "dashpots": dashpots, "total": total,
+            "residual": total[0] + input_work - dissipated - dashpots - total,
         }
 
     # ------------------------------------------------------------------ dense output

@@ -1,28 +1,41 @@
 """Compiled closed form of the modal equations on one segment (every damping regime).
 
-Each mode of a state obeys (paper eq. 9, generalised to every damping regime)
+Each coordinate ``z`` of a state (a mode, or one block of a state whose
+damping its modes do not diagonalise, see :mod:`~impactbeam.solver.blocks`)
+obeys (paper eq. 9, generalised to every damping regime)
 
-.. math:: \\ddot\\eta + 2a\\dot\\eta + \\omega^2\\eta = A + B\\tau + D\\sin(\\Omega\\tau + \\varphi),
-          \\qquad a = \\xi\\omega,
+.. math:: \\ddot z + 2a\\dot z + \\omega^2 z = A + B\\tau + D\\sin\\theta + E\\cos\\theta,
+          \\qquad \\theta = \\Omega\\tau + \\varphi,
 
 on a segment ``0 <= tau`` in which the state and the load form do not change.
-The solution is ``eta = eta_h + P`` with the particular part written on seven
-real coefficients (``p[0..6]``)
+The solution is ``z = z_h + P`` with the particular part written on eight
+real coefficients (``p[0..7]``)
 
 .. math:: P = p_0 + p_1\\tau + p_2\\tau^2 + p_3\\tau^3 + p_4\\sin\\theta
-          + p_5\\cos\\theta + p_6\\,\\tau\\cos\\theta,\\qquad \\theta = \\Omega\\tau + \\varphi,
+          + p_5\\cos\\theta + p_6\\,\\tau\\cos\\theta + p_7\\,\\tau\\sin\\theta,
 
-(``p_2, p_3`` only for rigid-body modes, ``p_6`` only at exact undamped
-resonance) and the homogeneous part from its initial values ``h0, dh0``
+(``p_2, p_3`` only for rigid-body coordinates, ``p_6, p_7`` only at exact
+undamped resonance) and the homogeneous part from its initial values ``h0, dh0``
 
-.. math:: \\eta_h = (e_C + a e_S) h_0 + e_S \\dot h_0, \\qquad
-          \\dot\\eta_h = -\\omega^2 e_S h_0 + (e_C - a e_S) \\dot h_0,
+.. math:: z_h = (e_C + a e_S) h_0 + e_S \\dot h_0, \\qquad
+          \\dot z_h = -\\omega^2 e_S h_0 + (e_C - a e_S) \\dot h_0,
 
 where ``e_C, e_S`` are ``e^{-a tau}`` times ``cos, sin(w tau)/w`` (regime 0,
 under-damped), ``1, tau`` (regime 1: critical damping, and rigid-body modes
-with ``omega = a = 0``) or ``cosh, sinh(w tau)/w`` (regime 2, over-damped),
-each evaluated without cancellation or overflow. This is the paper's eq. (10)
-with its ``B1, B2`` for every regime and for linear and sinusoidal loads.
+with ``omega = a = 0``) or ``cosh, sinh(w tau)/w`` (regime 2, over-damped,
+which includes a damped rigid-body coordinate, ``omega = 0 < a``), each
+evaluated without cancellation or overflow. This is the paper's eq. (10) with
+its ``B1, B2`` for every regime and for linear and sinusoidal loads.
+
+A quantity the solver watches (a contactor's opening, a deflection, a
+contact force) is a *row*: ``base + v . z + u . (z' - alpha(tau))`` with
+coefficient vectors ``v, u`` on the coordinates and their rates (``u = 0``
+for a state whose modes diagonalise its damping, where ``z`` are the modal
+coordinates) and ``alpha`` the part of the load that acts on a block's first
+equation. :func:`project` writes a row on one segment as, per coordinate, the
+value ``VH`` and slope ``VD`` of its homogeneous part at ``tau = 0`` plus one
+particular part ``PV``; since ``v z_h + u z_h'`` is itself a homogeneous
+solution, every bound and evaluation below needs only ``(VH, VD, PV)``.
 
 All functions are compiled with numba (``cache=True``); they run as plain
 Python when ``NUMBA_DISABLE_JIT=1``.
@@ -35,17 +48,19 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "kernel", "setup", "segment_setup", "state_at", "openings_at", "integral_of"]
+__all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "kernel", "setup", "segment_setup", "state_at",
+           "project", "integral_of", "derivatives", "curvature_bound", "jerk_bound", "workspace"]
 
 REG_UNDER = 0
 REG_CRITICAL = 1
 REG_OVER = 2
 EPS = 2.220446049250313e-16
+NP = 8  # coefficients of a particular part
 
 
 @njit(cache=True, nogil=True)
 def kernel(reg, a, w, tau):  # pragma: no cover - compiled
-    """``(e_C, e_S)`` of one mode at ``tau >= 0`` (see the module docstring)."""
+    """``(e_C, e_S)`` of one coordinate at ``tau >= 0`` (see the module docstring)."""
     if reg == REG_UNDER:
         e = math.exp(-a * tau)
         return e * math.cos(w * tau), e * math.sin(w * tau) / w
@@ -59,31 +74,44 @@ def kernel(reg, a, w, tau):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def particular(p, tau, Om, phi):  # pragma: no cover - compiled
-    """Particular part and its derivative from the seven coefficients ``p``."""
+    """Particular part and its derivative from the eight coefficients ``p``."""
     val = p[0] + tau * (p[1] + tau * (p[2] + tau * p[3]))
     der = p[1] + tau * (2.0 * p[2] + 3.0 * p[3] * tau)
     if Om != 0.0:
         th = Om * tau + phi
         s = math.sin(th)
         c = math.cos(th)
-        val += p[4] * s + p[5] * c + p[6] * tau * c
-        der += Om * (p[4] * c - p[5] * s) + p[6] * (c - Om * tau * s)
+        val += p[4] * s + p[5] * c + tau * (p[6] * c + p[7] * s)
+        der += Om * (p[4] * c - p[5] * s) + p[6] * (c - Om * tau * s) + p[7] * (s + Om * tau * c)
     return val, der
 
 
 @njit(cache=True, nogil=True)
-def setup(reg, a, om, load_A, load_B, load_D, Om, phi, eta0, deta0, h0, dh0, P):  # pragma: no cover - compiled
-    """Coefficients of a segment from its modal load and initial state.
+def derivative_coefficients(p, Om, out):  # pragma: no cover - compiled
+    """The eight coefficients of the derivative of the particular part ``p``."""
+    out[0] = p[1]
+    out[1] = 2.0 * p[2]
+    out[2] = 3.0 * p[3]
+    out[3] = 0.0
+    out[4] = -Om * p[5] + p[7]
+    out[5] = Om * p[4] + p[6]
+    out[6] = Om * p[7]
+    out[7] = -Om * p[6]
+
+
+@njit(cache=True, nogil=True)
+def setup(reg, a, om, load_A, load_B, load_D, load_E, Om, phi, eta0, deta0, h0, dh0, P):  # pragma: no cover
+    """Coefficients of a segment from its loads and initial state.
 
     Parameters
     ----------
     reg, a, om : ndarray, (n,)
-        Regime, decay ``xi omega`` and natural frequency of each mode.
-    load_A, load_B, load_D : ndarray, (n,)
-        Modal load ``A + B tau + D sin(Om tau + phi)``.
+        Regime, decay ``xi omega`` and natural frequency of each coordinate.
+    load_A, load_B, load_D, load_E : ndarray, (n,)
+        Load ``A + B tau + D sin(theta) + E cos(theta)``.
     eta0, deta0 : ndarray, (n,)
-        Modal displacement and velocity at ``tau = 0``.
-    h0, dh0, P : ndarray, (n,), (n,), (n, 7)
+        Coordinates and rates at ``tau = 0``.
+    h0, dh0, P : ndarray, (n,), (n,), (n, 8)
         Filled: homogeneous initial values and particular coefficients.
     """
     W2 = Om * Om
@@ -91,27 +119,35 @@ def setup(reg, a, om, load_A, load_B, load_D, Om, phi, eta0, deta0, h0, dh0, P):
         A = load_A[n]
         B = load_B[n]
         D = load_D[n]
-        for q in range(7):
+        E = load_E[n]
+        for q in range(NP):
             P[n, q] = 0.0
         o = om[n]
-        if o == 0.0:  # rigid-body mode: eta'' = f
+        an = a[n]
+        if o == 0.0 and an == 0.0:  # undamped rigid-body coordinate: z'' = f
             P[n, 2] = 0.5 * A
             P[n, 3] = B / 6.0
-            if D != 0.0:
+            if D != 0.0 or E != 0.0:
                 P[n, 4] = -D / W2
+                P[n, 5] = -E / W2
         else:
-            o2 = o * o
-            P[n, 0] = A / o2 - 2.0 * a[n] * B / (o2 * o2)
-            P[n, 1] = B / o2
-            if D != 0.0:
-                re = o2 - W2
-                im = 2.0 * a[n] * Om
+            if o == 0.0:  # damped rigid-body coordinate: z'' + 2a z' = f
+                P[n, 2] = B / (4.0 * an)
+                P[n, 1] = (A - 2.0 * P[n, 2]) / (2.0 * an)
+            else:
+                o2 = o * o
+                P[n, 0] = A / o2 - 2.0 * an * B / (o2 * o2)
+                P[n, 1] = B / o2
+            if D != 0.0 or E != 0.0:
+                re = o * o - W2
+                im = 2.0 * an * Om
                 den = re * re + im * im
-                if math.sqrt(den) <= 1e-12 * max(o2, W2):  # exact undamped resonance
+                if math.sqrt(den) <= 1e-12 * max(o * o, W2):  # exact undamped resonance
                     P[n, 6] = -D / (2.0 * o)
-                else:  # Im(D z / (re + i im)), z = exp(i theta)
-                    P[n, 4] = D * re / den
-                    P[n, 5] = -D * im / den
+                    P[n, 7] = E / (2.0 * o)
+                else:  # Im and Re of (D - i E)... : the response to exp(i theta) is 1 / (re + i im)
+                    P[n, 4] = (D * re + E * im) / den
+                    P[n, 5] = (E * re - D * im) / den
         p0, dp0 = particular(P[n], 0.0, Om, phi)
         h0[n] = eta0[n] - p0
         dh0[n] = deta0[n] - dp0
@@ -119,7 +155,7 @@ def setup(reg, a, om, load_A, load_B, load_D, Om, phi, eta0, deta0, h0, dh0, P):
 
 @njit(cache=True, nogil=True)
 def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover - compiled
-    """Modal displacement ``e`` and velocity ``d`` at ``tau`` (filled in place)."""
+    """Coordinates ``e`` and rates ``d`` at ``tau`` (filled in place)."""
     for n in range(om.size):
         eC, eS = kernel(reg[n], a[n], w[n], tau)
         pv, pd = particular(P[n], tau, Om, phi)
@@ -128,74 +164,143 @@ def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def openings_at(tau, reg, a, w, om, VH, VD, base, PV, Om, phi, g, dg):  # pragma: no cover - compiled
-    """Projected response ``g = base + V eta`` and ``dg = V eta'`` of several rows at ``tau``.
+def project(V, U, base, a, om, h0, dh0, P, AL, Om, VH, VD, PV, rows):  # pragma: no cover - compiled
+    """Write the rows ``base + V z + U (z' - alpha)`` of one segment as ``(VH, VD, PV)``.
 
-    ``VH[c, n] = V[c, n] h0[n]``, ``VD[c, n] = V[c, n] dh0[n]`` and ``PV = V @ P``
-    are prepared once per segment, so one evaluation costs one kernel per mode.
+    ``AL[n] = (alpha_0, alpha_1, alpha_sin)``: ``alpha_n(tau) = alpha_0 +
+    alpha_1 tau + alpha_sin sin(theta)``. ``VH[c, n]``, ``VD[c, n]`` are the
+    value and slope at 0 of coordinate ``n``'s homogeneous contribution to row
+    ``c``; ``PV[c]`` the coefficients of the row's particular part (without
+    ``base``). Only the first ``rows`` rows are written.
     """
-    nc = g.size
-    for c in range(nc):
-        pv, pd = particular(PV[c], tau, Om, phi)
-        g[c] = base[c] + pv
-        dg[c] = pd
-    for n in range(om.size):
-        eC, eS = kernel(reg[n], a[n], w[n], tau)
-        an = a[n]
-        k1 = eC + an * eS
-        k2 = -om[n] * om[n] * eS
-        k3 = eC - an * eS
-        for c in range(nc):
-            g[c] += k1 * VH[c, n] + eS * VD[c, n]
-            dg[c] += k2 * VH[c, n] + k3 * VD[c, n]
-
-
-@njit(cache=True, nogil=True)
-def project(V, base, h0, dh0, P, VH, VD, PV, rows):  # pragma: no cover - compiled
-    """Prepare :func:`openings_at` for the rows ``V`` (shape (m, n)); ``rows`` of them used."""
+    dP = np.empty(NP)
     for c in range(rows):
-        for q in range(7):
-            s = 0.0
-            for n in range(h0.size):
-                s += V[c, n] * P[n, q]
-            PV[c, q] = s
-        for n in range(h0.size):
-            VH[c, n] = V[c, n] * h0[n]
-            VD[c, n] = V[c, n] * dh0[n]
+        for q in range(NP):
+            PV[c, q] = 0.0
+    for n in range(h0.size):
+        o2 = om[n] * om[n]
+        ddh = -2.0 * a[n] * dh0[n] - o2 * h0[n]
+        derivative_coefficients(P[n], Om, dP)
+        dP[0] -= AL[n, 0]
+        dP[1] -= AL[n, 1]
+        dP[4] -= AL[n, 2]
+        for c in range(rows):
+            v = V[c, n]
+            u = U[c, n]
+            VH[c, n] = v * h0[n] + u * dh0[n]
+            VD[c, n] = v * dh0[n] + u * ddh
+            if v != 0.0 or u != 0.0:
+                for q in range(NP):
+                    PV[c, q] += v * P[n, q] + u * dP[q]
 
 
 @njit(cache=True, nogil=True)
-def curvature_bound(V, a, om, h0, dh0, PV, Om, tau_end, out):  # pragma: no cover - compiled
-    """Bound on ``|d^2/dtau^2 (V eta)|`` over ``[0, tau_end]`` for each row of ``V``.
+def _particular_bound(p, Om, tmax, order):  # pragma: no cover - compiled
+    """Bound on the ``order``-th (2 or 3) derivative of the particular part ``p`` on ``[0, tmax]``."""
+    W = abs(Om)
+    if order == 2:
+        m = 2.0 * abs(p[2]) + 6.0 * abs(p[3]) * tmax
+        if Om != 0.0:
+            m += W * W * (abs(p[4]) + abs(p[5])) + (abs(p[6]) + abs(p[7])) * (2.0 * W + W * W * tmax)
+        return m
+    m = 6.0 * abs(p[3])
+    if Om != 0.0:
+        m += W**3 * (abs(p[4]) + abs(p[5])) + (abs(p[6]) + abs(p[7])) * (3.0 * W * W + W**3 * tmax)
+    return m
 
-    The homogeneous energy ``(eta_h'^2 + omega^2 eta_h^2)/2`` of a mode with
-    ``a >= 0`` never grows, and ``eta_h'' = -2a eta_h' - omega^2 eta_h``, so
-    ``|eta_h''| <= (2a + omega) sqrt(eta_h'(0)^2 + omega^2 eta_h(0)^2)`` for
-    all ``tau >= 0``. The particular part is bounded term by term.
+
+@njit(cache=True, nogil=True)
+def curvature_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compiled
+    """Bound on the second derivative of each row over ``[0, tau_end]``.
+
+    Each coordinate's homogeneous contribution ``f`` to a row solves
+    ``f'' + 2a f' + omega^2 f = 0`` with ``f(0) = VH``, ``f'(0) = VD``; for
+    ``a >= 0`` its energy ``(f'^2 + omega^2 f^2)/2`` never grows, so
+    ``|f''| <= (2a + omega) sqrt(f'(0)^2 + omega^2 f(0)^2)`` for all
+    ``tau >= 0``. The particular part is bounded term by term.
     """
     tmax = max(tau_end, 0.0)
     for c in range(out.size):
-        p = PV[c]
-        m = 2.0 * abs(p[2]) + 6.0 * abs(p[3]) * tmax
-        if Om != 0.0:
-            m += Om * Om * (abs(p[4]) + abs(p[5])) + abs(p[6]) * (2.0 * abs(Om) + Om * Om * tmax)
-        out[c] = m
+        out[c] = _particular_bound(PV[c], Om, tmax, 2)
     for n in range(om.size):
         o = om[n]
-        amp = (2.0 * a[n] + o) * math.sqrt(dh0[n] * dh0[n] + o * o * h0[n] * h0[n])
-        if amp != 0.0:
+        k = 2.0 * a[n] + o
+        if k != 0.0:
             for c in range(out.size):
-                out[c] += abs(V[c, n]) * amp
+                vh = VH[c, n]
+                vd = VD[c, n]
+                out[c] += k * math.sqrt(vd * vd + o * o * vh * vh)
     for c in range(out.size):
         out[c] *= 1.0 + 1e-12  # round-off margin
 
 
 @njit(cache=True, nogil=True)
-def derivatives(v, base, a, om, eta0, deta0, load_A, load_B, load_D, Om, phi, kmax, out, mag):  # pragma: no cover
-    """Exact derivatives ``d^k/dtau^k (base + v eta)`` at ``tau = 0``, k = 0..kmax.
+def jerk_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compiled
+    """Bound on the third derivative of each row over ``[0, tau_end]``.
 
-    From the equation of motion, ``eta^(k+2) = f^(k) - 2a eta^(k+1) - omega^2
-    eta^(k)``; ``mag[k]`` is the same sum taken with absolute values (the scale
+    The slope of a homogeneous solution is a homogeneous solution too, so
+    :func:`curvature_bound`'s argument applies to it, from ``(f'(0), f''(0))``.
+    """
+    tmax = max(tau_end, 0.0)
+    for c in range(out.size):
+        out[c] = _particular_bound(PV[c], Om, tmax, 3)
+    for n in range(om.size):
+        o = om[n]
+        k = 2.0 * a[n] + o
+        if k != 0.0:
+            for c in range(out.size):
+                vd = VD[c, n]
+                dd = -2.0 * a[n] * vd - o * o * VH[c, n]
+                out[c] += k * math.sqrt(dd * dd + o * o * vd * vd)
+    for c in range(out.size):
+        out[c] *= 1.0 + 1e-12
+
+
+@njit(cache=True, nogil=True)
+def curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, out, work_h, work_d):  # pragma: no cover
+    """:func:`curvature_bound` valid on ``[tau, tau_end]``, from the homogeneous parts at ``tau``.
+
+    The homogeneous energy only decreases, so the bound tightens as a damped
+    response decays; the scan refreshes it as it goes. ``work_h, work_d``
+    are scratch arrays of the shape of ``VH``.
+    """
+    rows = out.size
+    for n in range(om.size):
+        eC, eS = kernel(reg[n], a[n], w[n], tau)
+        k1 = eC + a[n] * eS
+        k2 = -om[n] * om[n] * eS
+        k3 = eC - a[n] * eS
+        for c in range(rows):
+            work_h[c, n] = k1 * VH[c, n] + eS * VD[c, n]
+            work_d[c, n] = k2 * VH[c, n] + k3 * VD[c, n]
+    curvature_bound(work_h, work_d, a, om, PV, Om, tau_end, out)
+
+
+@njit(cache=True, nogil=True)
+def _load_derivative(A, B, D, E, Om, sphi, cphi, j):  # pragma: no cover - compiled
+    """``d^j/dtau^j (A + B tau + D sin theta + E cos theta)`` at ``tau = 0``."""
+    if j == 0:
+        return A + D * sphi + E * cphi
+    if j == 1:
+        return B + Om * (D * cphi - E * sphi)
+    s = Om**j
+    r = j % 4
+    if r == 0:
+        return s * (D * sphi + E * cphi)
+    if r == 1:
+        return s * (D * cphi - E * sphi)
+    if r == 2:
+        return -s * (D * sphi + E * cphi)
+    return -s * (D * cphi - E * sphi)
+
+
+@njit(cache=True, nogil=True)
+def derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, out, mag):
+    # pragma: no cover - compiled
+    """Exact derivatives ``d^k/dtau^k (base + v z + u (z' - alpha))`` at ``tau = 0``, k = 0..kmax.
+
+    From the equation of motion, ``z^(k+2) = f^(k) - 2a z^(k+1) - omega^2
+    z^(k)``; ``mag[k]`` is the same sum taken with absolute values (the scale
     against which a derivative counts as zero up to round-off).
     """
     sphi = math.sin(phi)
@@ -205,137 +310,133 @@ def derivatives(v, base, a, om, eta0, deta0, load_A, load_B, load_D, Om, phi, km
         mag[k] = 0.0
     out[0] = base
     mag[0] = abs(base)
-    hist = np.empty(kmax + 1)
-    habs = np.empty(kmax + 1)
+    hist = np.empty(kmax + 2)
+    habs = np.empty(kmax + 2)
     for n in range(om.size):
+        vn = v[n]
+        un = u[n]
+        if vn == 0.0 and un == 0.0:
+            continue
         hist[0] = eta0[n]
         habs[0] = abs(eta0[n])
-        if kmax >= 1:
-            hist[1] = deta0[n]
-            habs[1] = abs(deta0[n])
-        for k in range(2, kmax + 1):
-            j = k - 2  # derivative order of the load
-            D = load_D[n]
-            if j == 0:
-                f = load_A[n] + D * sphi
-            elif j == 1:
-                f = load_B[n] + D * Om * cphi
-            else:
-                r = j % 4
-                s = Om**j
-                f = D * s * (sphi if r == 0 else cphi if r == 1 else -sphi if r == 2 else -cphi)
+        hist[1] = deta0[n]
+        habs[1] = abs(deta0[n])
+        for k in range(2, kmax + 2):
+            f = _load_derivative(load_A[n], load_B[n], load_D[n], load_E[n], Om, sphi, cphi, k - 2)
             hist[k] = f - 2.0 * a[n] * hist[k - 1] - om[n] * om[n] * hist[k - 2]
             habs[k] = abs(f) + 2.0 * a[n] * habs[k - 1] + om[n] * om[n] * habs[k - 2]
         for k in range(kmax + 1):
-            out[k] += v[n] * hist[k]
-            mag[k] += abs(v[n]) * habs[k]
+            al = 0.0
+            if un != 0.0:
+                al = _load_derivative(AL[n, 0], AL[n, 1], AL[n, 2], 0.0, Om, sphi, cphi, k)
+            out[k] += vn * hist[k] + un * (hist[k + 1] - al)
+            mag[k] += abs(vn) * habs[k] + abs(un) * (habs[k + 1] + abs(al))
 
 
 @njit(cache=True, nogil=True)
-def integral_of(v, reg, a, w, om, h0, dh0, P, Om, phi, T):  # pragma: no cover - compiled
-    """``int_0^T v . eta(tau) dtau`` in closed form.
+def _integral_particular(p, Om, phi, T):  # pragma: no cover - compiled
+    """``int_0^T`` of the particular part ``p``."""
+    ip = T * (p[0] + T * (p[1] / 2.0 + T * (p[2] / 3.0 + T * p[3] / 4.0)))
+    if Om != 0.0:
+        th1 = Om * T + phi
+        s0 = math.sin(phi)
+        c0 = math.cos(phi)
+        s1 = math.sin(th1)
+        c1 = math.cos(th1)
+        ip += p[4] * (c0 - c1) / Om + p[5] * (s1 - s0) / Om
+        if p[6] != 0.0:  # int tau cos(theta) = [tau sin/Om + cos/Om^2]
+            ip += p[6] * (T * s1 / Om + (c1 - c0) / (Om * Om))
+        if p[7] != 0.0:  # int tau sin(theta) = [-tau cos/Om + sin/Om^2]
+            ip += p[7] * (-T * c1 / Om + (s1 - s0) / (Om * Om))
+    return ip
 
-    For ``omega > 0`` the equation of motion gives ``int eta = (int f - [eta'] -
-    2a [eta]) / omega^2``, with ``[.]`` the change over the interval; rigid-body
-    modes integrate their polynomial and sine directly.
+
+@njit(cache=True, nogil=True)
+def integral_of(VH, VD, PV, reg, a, w, om, Om, phi, T):  # pragma: no cover - compiled
+    """``int_0^T`` of row 0 of a projection (:func:`project`), without its base, in closed form.
+
+    For ``omega > 0`` a homogeneous solution integrates through its equation,
+    ``int f = -([f'] + 2a [f]) / omega^2`` (``[.]`` the change over the
+    interval); a rigid-body coordinate integrates its kernel directly.
     """
-    total = 0.0
+    total = _integral_particular(PV[0], Om, phi, T)
     for n in range(om.size):
-        if v[n] == 0.0:
+        vh = VH[0, n]
+        vd = VD[0, n]
+        if vh == 0.0 and vd == 0.0:
             continue
         eC, eS = kernel(reg[n], a[n], w[n], T)
-        hT = (eC + a[n] * eS) * h0[n] + eS * dh0[n]
-        dhT = -om[n] * om[n] * eS * h0[n] + (eC - a[n] * eS) * dh0[n]
-        p = P[n]
+        an = a[n]
         o = om[n]
-        if o == 0.0:
-            ih = h0[n] * T + 0.5 * dh0[n] * T * T
-        else:
-            ih = -((dhT - dh0[n]) + 2.0 * a[n] * (hT - h0[n])) / (o * o)
-        ip = T * (p[0] + T * (p[1] / 2.0 + T * (p[2] / 3.0 + T * p[3] / 4.0)))
-        if Om != 0.0:
-            th1 = Om * T + phi
-            ip += p[4] * (math.cos(phi) - math.cos(th1)) / Om + p[5] * (math.sin(th1) - math.sin(phi)) / Om
-            if p[6] != 0.0:  # int tau cos(theta) = [tau sin/Om + cos/Om^2]
-                ip += p[6] * (T * math.sin(th1) / Om + (math.cos(th1) - math.cos(phi)) / (Om * Om))
-        total += v[n] * (ih + ip)
+        fT = (eC + an * eS) * vh + eS * vd
+        dfT = -o * o * eS * vh + (eC - an * eS) * vd
+        if o != 0.0:
+            total += -((dfT - vd) + 2.0 * an * (fT - vh)) / (o * o)
+        elif an == 0.0:
+            total += vh * T + 0.5 * vd * T * T
+        else:  # f = vh + vd (1 - exp(-2 a tau)) / (2 a)
+            total += vh * T + vd / (2.0 * an) * (T + math.expm1(-2.0 * an * T) / (2.0 * an))
     return total
 
 
 @njit(cache=True, nogil=True)
-def segment_setup(s, kp, t, eta, deta, reg, dec, om, pw, Wc, smask, gap, side, kst,
-                  pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD):  # pragma: no cover - compiled
+def segment_setup(s, kp, t, eta, deta, reg, dec, om, bu, au, Bc, Ac, bp, ap, smask, gap, side, kst,
+                  pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD, lE, AL):
+    # pragma: no cover - compiled
     """Closed-form coefficients of a segment starting at ``t`` in state slot ``s``, load piece ``kp``.
 
-    The modal load is ``p_n u(t)`` (paper eq. 8, ``u`` the piece's time law)
-    plus, for every engaged contactor with a gap, the constant point force
-    ``side k gap`` at the contactor (the sign convention of the model). Fills ``h0, dh0, P``
-    and the load coefficients ``lA, lB, lD``; returns ``(Omega, phi)``.
+    The load on each coordinate's two equations (:mod:`~impactbeam.solver.blocks`):
+    ``alpha = au u(t) + sum_c g_c Ac[c] + ap`` on the first and ``beta = bu u(t)
+    + sum_c g_c Bc[c] + bp`` on the second, with ``u`` the piece's time law
+    (paper eq. 8), ``g_c = side k gap`` the constant point force of every
+    engaged contactor with a gap (the sign convention of the model) and
+    ``ap, bp`` the preload. A coordinate then obeys its oscillator equation
+    with the load ``beta + 2a alpha + alpha'``. For a state whose modes
+    diagonalise its damping ``au = Ac = ap = 0``, ``bu`` is the paper's
+    ``p_n`` and ``Bc`` the mode shapes at the contactors. Fills ``h0, dh0, P``,
+    the loads ``lA, lB, lD, lE`` and ``AL`` (``alpha``'s coefficients);
+    returns ``(Omega, phi)``.
     """
     tau_p = t - pt0[kp]
-    u = pconst[kp] + pslope[kp] * tau_p
-    nm = eta.size
-    for n in range(nm):
-        lA[n] = pw[s, n] * u
-        lB[n] = pw[s, n] * pslope[kp]
-        lD[n] = pw[s, n] * pamp[kp]
-    mask = smask[s]
-    for c in range(gap.size):
-        if (mask >> c) & 1 and gap[c] != 0.0:
-            f = side[c] * kst[c] * gap[c]
-            for n in range(nm):
-                lA[n] += f * Wc[s, c, n]
     Om = pOm[kp]
     phi = pphase[kp] + Om * tau_p
-    setup(reg[s], dec[s], om[s], lA, lB, lD, Om, phi, eta, deta, h0, dh0, P)
+    u0 = pconst[kp] + pslope[kp] * tau_p
+    u1 = pslope[kp]
+    uD = pamp[kp]
+    nm = eta.size
+    mask = smask[s]
+    for n in range(nm):
+        ac = ap[s, n]
+        bc = bp[s, n]
+        for c in range(gap.size):
+            if (mask >> c) & 1 and gap[c] != 0.0:
+                f = side[c] * kst[c] * gap[c]
+                ac += f * Ac[s, c, n]
+                bc += f * Bc[s, c, n]
+        an = dec[s, n]
+        x = au[s, n]
+        y = bu[s, n] + 2.0 * an * x
+        lA[n] = y * u0 + bc + 2.0 * an * ac + x * u1
+        lB[n] = y * u1
+        lD[n] = y * uD
+        lE[n] = x * uD * Om
+        AL[n, 0] = x * u0 + ac
+        AL[n, 1] = x * u1
+        AL[n, 2] = x * uD
+    setup(reg[s], dec[s], om[s], lA, lB, lD, lE, Om, phi, eta, deta, h0, dh0, P)
     return Om, phi
 
 
 @njit(cache=True, nogil=True)
-def jerk_bound(V, a, om, h0, dh0, PV, Om, tau_end, out):  # pragma: no cover - compiled
-    """Bound on the third derivative of ``V eta`` over ``[0, tau_end]`` for each row of ``V``.
-
-    The velocity of the homogeneous part obeys the same homogeneous equation,
-    so its energy never grows and the third derivative is bounded by
-    ``(2a + omega) sqrt(eta_h2(0)^2 + omega^2 eta_h1(0)^2)`` (``eta_h1``,
-    ``eta_h2`` the first and second derivatives); the particular part term by term.
-    """
-    tmax = max(tau_end, 0.0)
-    W = abs(Om)
-    for c in range(out.size):
-        p = PV[c]
-        m = 6.0 * abs(p[3])
-        if Om != 0.0:
-            m += W**3 * (abs(p[4]) + abs(p[5])) + abs(p[6]) * (3.0 * W * W + W**3 * tmax)
-        out[c] = m
-    for n in range(om.size):
-        o = om[n]
-        dd = -2.0 * a[n] * dh0[n] - o * o * h0[n]
-        amp = (2.0 * a[n] + o) * math.sqrt(dd * dd + o * o * dh0[n] * dh0[n])
-        if amp != 0.0:
-            for c in range(out.size):
-                out[c] += abs(V[c, n]) * amp
-    for c in range(out.size):
-        out[c] *= 1.0 + 1e-12
-
-
-@njit(cache=True, nogil=True)
-def curvature_bound_at(tau, V, reg, a, w, om, h0, dh0, PV, Om, tau_end, out):  # pragma: no cover - compiled
-    """:func:`curvature_bound` valid on ``[tau, tau_end]``, from the homogeneous state at ``tau``.
-
-    The homogeneous energy only decreases, so the bound tightens as a damped
-    response decays; the scan refreshes it as it goes.
-    """
-    hh = np.empty(om.size)
-    dd = np.empty(om.size)
-    for n in range(om.size):
-        eC, eS = kernel(reg[n], a[n], w[n], tau)
-        hh[n] = (eC + a[n] * eS) * h0[n] + eS * dh0[n]
-        dd[n] = -om[n] * om[n] * eS * h0[n] + (eC - a[n] * eS) * dh0[n]
-    curvature_bound(V, a, om, hh, dd, PV, Om, tau_end, out)
+def alpha_at(AL, tau, Om, phi, out):  # pragma: no cover - compiled
+    """``alpha_n(tau)`` of every coordinate (:func:`segment_setup`)."""
+    s = math.sin(Om * tau + phi) if Om != 0.0 else math.sin(phi)
+    for n in range(out.size):
+        out[n] = AL[n, 0] + AL[n, 1] * tau + AL[n, 2] * s
 
 
 @njit(cache=True, nogil=True)
 def workspace(nm):  # pragma: no cover - compiled
-    """Work arrays of :func:`segment_setup`: ``h0, dh0, P, lA, lB, lD`` for ``nm`` modes."""
-    return np.empty(nm), np.empty(nm), np.empty((nm, 7)), np.empty(nm), np.empty(nm), np.empty(nm)
+    """Work arrays of :func:`segment_setup`: ``h0, dh0, P, lA, lB, lD, lE, AL`` for ``nm`` coordinates."""
+    return (np.empty(nm), np.empty(nm), np.empty((nm, NP)), np.empty(nm), np.empty(nm), np.empty(nm),
+            np.empty(nm), np.empty((nm, 3)))

@@ -29,29 +29,67 @@ import numpy as np
 from numba import njit
 
 from ._closed import (
-    curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup, state_at, workspace,
+    NP, alpha_at, curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup, state_at,
+    workspace,
 )
 from ._events import brent
+from ._loop import load_value, to_modal
 
 __all__ = ["sample", "extremum", "integral"]
 
 
 @njit(cache=True, nogil=True)
+def _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side, kst,
+           pt0, pconst, pslope, pamp, pOm, pphase, ws):  # pragma: no cover - compiled
+    """Closed form of segment ``j`` (:func:`~impactbeam.solver._closed.segment_setup`) into the workspace ``ws``."""
+    h0, dh0, P, lA, lB, lD, lE, AL = ws
+    return segment_setup(seg_s[j], seg_k[j], seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, LW[:, 0], LW[:, 1],
+                         CW[:, 0], CW[:, 1], LW[:, 2], LW[:, 3], smask, gap, side, kst, pt0, pconst, pslope, pamp,
+                         pOm, pphase, h0, dh0, P, lA, lB, lD, lE, AL)
+
+
+@njit(cache=True, nogil=True)
+def slot_row(gen, G, r, rate, v, u):  # pragma: no cover - compiled
+    """The modal-frame row ``r . (eta + rate eta')`` as coefficients ``(v, u)`` on a slot's ``(z, z' - alpha)``."""
+    nm = r.size
+    if gen == 0:
+        for n in range(nm):
+            v[n] = r[n]
+            u[n] = rate * r[n]
+        return
+    for n in range(nm):
+        sv = 0.0
+        su = 0.0
+        for m in range(nm):
+            sv += r[m] * (G[0, m, n] + rate * G[0, nm + m, n])
+            su += r[m] * (G[1, m, n] + rate * G[1, nm + m, n])
+        v[n] = sv
+        u[n] = su
+
+
+@njit(cache=True, nogil=True)
 def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, want_modal, want_energy,
-           seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, pw, Wc, smask, gap, side, kst,
-           pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+           seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, omo, Wc, LW, CW, gen, G, Cd, pw, pre,
+           smask, gap, side, kst, dash, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
     """Evaluate the solution at times ``tq`` (segment ``segidx[i]`` each).
 
-    ``rows[s]`` (shape (S, r, n)) holds the shapes of state slot ``s`` at the
-    requested points; ``out_rows[i, j]`` and ``out_drows[i, j]`` receive
+    ``rows[s]`` (shape (S, r, n)) holds the mode shapes of state slot ``s`` at
+    the requested points; ``out_rows[i, j]`` and ``out_drows[i, j]`` receive
     ``w`` and ``w_t`` there. With ``want_modal`` the modal coordinates go to
-    ``out_eta``/``out_deta``; with ``want_energy`` ``energies[i]`` receives
-    (kinetic, modal strain, external load power, damping power).
+    ``out_eta``/``out_deta`` (in the slot's modal frame); with ``want_energy``
+    ``energies[i]`` receives (kinetic, modal strain, external load power
+    (excitation and preload), power dissipated by the beam's damping, power
+    dissipated by the engaged contactors' dashpots).
     """
     nm = seg_eta.shape[1]
-    h0, dh0, P, lA, lB, lD = workspace(nm)
+    ws = workspace(nm)
+    h0, dh0, P = ws[0], ws[1], ws[2]
+    AL = ws[7]
+    z = np.empty(nm)
+    dz = np.empty(nm)
     e = np.empty(nm)
     d = np.empty(nm)
+    alpha = np.empty(nm)
     cur = -1
     Om = 0.0
     phi = 0.0
@@ -60,11 +98,14 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
         s = seg_s[j]
         kp = seg_k[j]
         if j != cur:
-            Om, phi = segment_setup(s, kp, seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, pw, Wc, smask,
-                                    gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD)
+            Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
+                             kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
             cur = j
         tau = tq[i] - seg_t0[j]
-        state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, e, d)
+        state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz)
+        if gen[s]:
+            alpha_at(AL, tau, Om, phi, alpha)
+        to_modal(gen[s], G[s], z, dz, alpha, e, d)
         for r in range(out_rows.shape[1]):
             acc = 0.0
             dacc = 0.0
@@ -77,23 +118,37 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
             out_eta[i, :] = e
             out_deta[i, :] = d
         if want_energy:
-            tp = tq[i] - pt0[kp]
-            u = pconst[kp] + pslope[kp] * tp
-            if pamp[kp] != 0.0:
-                u += pamp[kp] * math.sin(pOm[kp] * tp + pphase[kp])
+            u = load_value(kp, tq[i], pt0, pconst, pslope, pamp, pOm, pphase)
             kin = 0.0
             strain = 0.0
             lp = 0.0
             dp = 0.0
             for n in range(nm):
                 kin += d[n] * d[n]
-                strain += om[s, n] * om[s, n] * e[n] * e[n]
-                lp += pw[s, n] * u * d[n]
-                dp += 2.0 * dec[s, n] * d[n] * d[n]
+                strain += omo[s, n] * omo[s, n] * e[n] * e[n]
+                lp += (pw[s, n] * u + pre[s, n]) * d[n]
+            if gen[s]:
+                for n in range(nm):
+                    acc = 0.0
+                    for m in range(nm):
+                        acc += Cd[s, n, m] * d[m]
+                    dp += d[n] * acc
+            else:
+                for n in range(nm):
+                    dp += 2.0 * dec[s, n] * d[n] * d[n]
+            cp = 0.0
+            mask = smask[s]
+            for c in range(gap.size):
+                if (mask >> c) & 1 and dash[c] > 0.0:
+                    vc = 0.0
+                    for n in range(nm):
+                        vc += Wc[s, c, n] * d[n]
+                    cp += dash[c] * vc * vc
             energies[i, 0] = 0.5 * kin
             energies[i, 1] = 0.5 * strain
             energies[i, 2] = lp
-            energies[i, 3] = dp
+            energies[i, 3] = dp - cp
+            energies[i, 4] = cp
 
 
 @njit(cache=True, nogil=True)
@@ -120,6 +175,7 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - 
         sn = math.sin(th)
         cs = math.cos(th)
         ddu += -Om * Om * (p[4] * sn + p[5] * cs) + p[6] * (-2.0 * Om * sn - Om * Om * tau * cs)
+        ddu += p[7] * (2.0 * Om * cs - Om * Om * tau * sn)
     u += base[0]
     for n in range(om.size):
         eC, eS = kernel(reg[n], a[n], w[n], tau)
@@ -213,23 +269,31 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
 
 
 @njit(cache=True, nogil=True)
-def extremum(lo, hi, sign, offset, row, cond_bit, atol, xtol, Wr, out_val, out_t,
-             seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, pw, Wc, smask, gap, side, kst,
-             pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
-    """Maxima of ``sign[q] (Wr[row[q], s] . eta + offset[q])`` over ``[lo[q], hi[q]]`` and their times.
+def extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val, out_t,
+             seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
+             kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+    """Maxima of ``sign[q] (Wr[row[q], s] . (eta + rate[q] eta') + offset[q])`` over ``[lo[q], hi[q]]``.
 
-    Query ``q`` counts only segments whose state has contactor ``cond_bit[q]``
-    engaged (``cond_bit < 0``: all segments); ``(-inf, nan)`` when none qualifies.
+    Also their times. ``eta`` are the modal coordinates in slot ``s``'s frame
+    (``rate``: a velocity term, e.g. a dashpot's force). Query ``q`` counts
+    only segments whose state has contactor ``cond_bit[q]`` engaged
+    (``cond_bit < 0``: all segments); ``(-inf, nan)`` when none qualifies.
     """
     nm = seg_eta.shape[1]
-    h0, dh0, P, lA, lB, lD = workspace(nm)
+    ws = workspace(nm)
+    h0, dh0, P = ws[0], ws[1], ws[2]
+    AL = ws[7]
     V = np.empty((1, nm))
+    U = np.empty((1, nm))
     base = np.empty(1)
     VH = np.empty((1, nm))
     VD = np.empty((1, nm))
-    PV = np.empty((1, 7))
+    PV = np.empty((1, NP))
     M = np.empty(1)
     M3 = np.empty(1)
+    alpha = np.zeros(nm)
+    e = np.empty(nm)
+    d = np.empty(nm)
     stack = np.empty((128, 8))
     for q in range(lo.size):
         best = -np.inf
@@ -241,9 +305,14 @@ def extremum(lo, hi, sign, offset, row, cond_bit, atol, xtol, Wr, out_val, out_t
                 break
             s = seg_s[j]
             if seg_t0[j] >= lo[q] and (cond_bit[q] < 0 or ((smask[s] >> cond_bit[q]) & 1) == 1):
+                if gen[s]:
+                    Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask,
+                                     gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
+                    alpha_at(AL, 0.0, Om, phi, alpha)
+                to_modal(gen[s], G[s], seg_eta[j], seg_deta[j], alpha, e, d)
                 v = 0.0
                 for n in range(nm):
-                    v += Wr[row[q], s, n] * seg_eta[j, n]
+                    v += Wr[row[q], s, n] * (e[n] + rate[q] * d[n])
                 v = sign[q] * (v + offset[q])
                 if v > best:
                     best = v
@@ -258,15 +327,16 @@ def extremum(lo, hi, sign, offset, row, cond_bit, atol, xtol, Wr, out_val, out_t
             s = seg_s[j]
             if cond_bit[q] >= 0 and ((smask[s] >> cond_bit[q]) & 1) == 0:
                 continue
-            Om, phi = segment_setup(s, seg_k[j], seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, pw, Wc,
-                                    smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
-                                    h0, dh0, P, lA, lB, lD)
+            Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
+                             kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
+            slot_row(gen[s], G[s], Wr[row[q], s], rate[q], V[0], U[0])
             for n in range(nm):
-                V[0, n] = sign[q] * Wr[row[q], s, n]
+                V[0, n] *= sign[q]
+                U[0, n] *= sign[q]
             base[0] = sign[q] * offset[q]
-            project(V, base, h0, dh0, P, VH, VD, PV, 1)
-            curvature_bound(V, dec[s], om[s], h0, dh0, PV, Om, a1 - seg_t0[j], M)
-            jerk_bound(V, dec[s], om[s], h0, dh0, PV, Om, a1 - seg_t0[j], M3)
+            project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, 1)
+            curvature_bound(VH, VD, dec[s], om[s], PV, Om, a1 - seg_t0[j], M)
+            jerk_bound(VH, VD, dec[s], om[s], PV, Om, a1 - seg_t0[j], M3)
             best, tloc = _segment_max(a0 - seg_t0[j], a1 - seg_t0[j], M[0], M3[0], best, atol, xtol,
                                       stack, reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi)
             if not np.isnan(tloc):
@@ -276,13 +346,18 @@ def extremum(lo, hi, sign, offset, row, cond_bit, atol, xtol, Wr, out_val, out_t
 
 
 @njit(cache=True, nogil=True)
-def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, pw, Wc,
-             smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen,
+             G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
     """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form."""
     nm = seg_eta.shape[1]
-    h0, dh0, P, lA, lB, lD = workspace(nm)
-    e = np.empty(nm)
-    d = np.empty(nm)
+    ws = workspace(nm)
+    h0, dh0, P, lA, lB, lD, lE, AL = ws
+    V = np.empty((1, nm))
+    U = np.empty((1, nm))
+    base = np.zeros(1)
+    VH = np.empty((1, nm))
+    VD = np.empty((1, nm))
+    PV = np.empty((1, NP))
     for q in range(lo.size):
         total = 0.0
         j0 = max(np.searchsorted(seg_t1, lo[q]) - 1, 0)
@@ -294,12 +369,12 @@ def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_de
             if a1 <= a0:
                 continue
             s = seg_s[j]
-            Om, phi = segment_setup(s, seg_k[j], seg_t0[j], seg_eta[j], seg_deta[j], reg, dec, om, pw, Wc,
-                                    smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
-                                    h0, dh0, P, lA, lB, lD)
-            if a0 > seg_t0[j]:  # restart the closed form at a0
-                state_at(a0 - seg_t0[j], reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, e, d)
-                Om, phi = segment_setup(s, seg_k[j], a0, e, d, reg, dec, om, pw, Wc, smask, gap, side, kst,
-                                        pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD)
-            total += integral_of(Wr[row[q], s], reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, a1 - a0)
+            Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
+                             kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
+            slot_row(gen[s], G[s], Wr[row[q], s], 0.0, V[0], U[0])
+            project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, 1)
+            # the row from a0: its homogeneous part restarted there, the particular part shifted
+            total += integral_of(VH, VD, PV, reg[s], dec[s], wdh[s], om[s], Om, phi, a1 - seg_t0[j])
+            if a0 > seg_t0[j]:
+                total -= integral_of(VH, VD, PV, reg[s], dec[s], wdh[s], om[s], Om, phi, a0 - seg_t0[j])
         out[q] = total

@@ -225,13 +225,13 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
 
 @njit(cache=True, nogil=True)
 def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg, a, w, om, VH, VD, base, PV, Om, phi,
-         V, h0, dh0):
+         work_h, work_d):
     # pragma: no cover - compiled
     """Advance from ``tau0`` to the first switching event before ``tau_end``.
 
     ``g, dg`` hold the openings at ``tau0`` on entry; ``M`` their curvature
-    bounds, refreshed every 32 steps from the rows ``V`` and the homogeneous
-    initial values ``h0, dh0``. Returns ``(tau, c, n)``:
+    bounds, refreshed every 32 steps from the projected rows (``work_h``,
+    ``work_d``: scratch arrays shaped like ``VH``). Returns ``(tau, c, n)``:
     the event time and row, ``c = -1`` if none up to ``tau_end``, or ``c = -2``
     when ``budget`` evaluations were spent first (``tau`` is then the point
     reached, every row proven consistent up to it); ``n`` evaluations used.
@@ -274,22 +274,23 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg
             g[c] = gb[c]
             dg[c] = dgb[c]
         if used % 32 == 0:  # a decaying response earns longer steps
-            curvature_bound_at(tau, V, reg, a, w, om, h0, dh0, PV, Om, tau_end, M)
+            curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d)
         if used >= budget and tau < tau_end:
             return tau, -2, used
     return tau_end, -1, used
 
 
 @njit(cache=True, nogil=True)
-def departure(v, base, a, om, eta0, deta0, load_A, load_B, load_D, Om, phi, dvec, mag):  # pragma: no cover
-    """Sign (-1, 0, +1) of the first derivative of ``base + v eta`` at 0 that is not round-off.
+def departure(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, dvec, mag):
+    # pragma: no cover - compiled
+    """Sign (-1, 0, +1) of the first derivative of the row ``(v, u, base)`` at 0 that is not round-off.
 
     A derivative counts as zero when it is below ``64 eps`` times the same sum
     taken with absolute values (:func:`~impactbeam.solver._closed.derivatives`).
     Orders 1 to ``dvec.size - 1`` are tried; 0 when all vanish (e.g. at rest).
     """
     kmax = dvec.size - 1
-    derivatives(v, base, a, om, eta0, deta0, load_A, load_B, load_D, Om, phi, kmax, dvec, mag)
+    derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, dvec, mag)
     for k in range(1, kmax + 1):
         if abs(dvec[k]) > 64.0 * EPS * mag[k]:
             return 1 if dvec[k] > 0.0 else -1

@@ -4,13 +4,37 @@
 piece) it prepares the closed form (:mod:`~impactbeam.solver._closed`),
 judges the contactors at the segment start, scans for the first switching
 event (:mod:`~impactbeam.solver._events`), records the segment and, at an
-event, switches the state and carries the modal coordinates across with the
-state's transfer matrix (paper eq. 12, or the exact change of basis of a
-shared Ritz basis).
+event, switches the state and carries the state across with the state's
+transfer matrix (paper eq. 12, or the exact change of basis of a shared Ritz
+basis), in the states' own modal frames.
+
+Each state slot holds its coordinates ``z`` (:mod:`~impactbeam.solver.blocks`):
+its modal coordinates when its modes diagonalise its damping (``gen = 0``),
+else one coordinate per block of its first-order system, with the maps
+``G`` (coordinates to the modal frame) and ``H`` (back). The packed arrays,
+per slot ``s``:
+
+* ``reg, dec, wdh, om``: regime, decay, damped frequency and frequency of
+  each coordinate; ``omo``: the state's modal frequencies (energies);
+* ``Wc[s, c]``: mode shapes at the contactors (modal frame);
+* ``LW[s] = (bu, au, bp, ap)``: loads per unit of the excitation's time law
+  (``bu`` on the second, ``au`` on the first equation of a coordinate) and
+  of the preload; ``CW[s] = (Bc, Ac)``: loads per unit point force at each
+  contactor (its gap force);
+* ``RW[s] = (RV, RU, QV, QU)``: each contactor's deflection (``RV . z + RU .
+  (z' - alpha)``) and velocity (``QV``, ``QU``) rows;
+* ``G[s]``, ``H[s]``, ``Cd[s]``: the maps of a general state and its damping
+  matrix in the modal frame (energies).
+
+A contactor with a dashpot (``dash[c] > 0``) switches on its force ``k d +
+c d'``: engaged it stays while that force is positive; released with a
+penetration left (``phase[c] = 1``) it engages again if the force turns
+positive before the penetration returns to 0, which ends that phase.
 
 It never needs Python in between, but it returns to Python when it lacks
 something, with a status code; Python supplies it and calls :func:`run` again,
-which resumes where it stopped (all loop variables live in ``fc``/``ic``):
+which resumes where it stopped (all loop variables live in ``fc``/``ic`` and
+the arrays passed in):
 
 * ``NEED_STATE``: the state with engaged-contactor bit mask ``ic[REQ_A]`` is
   not built (states are built on demand, so memory and time do not grow like
@@ -32,7 +56,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._closed import curvature_bound, project, segment_setup, state_at, workspace
+from ._closed import NP, alpha_at, curvature_bound, particular, project, segment_setup, state_at, workspace
 from ._events import departure, scan
 
 DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
@@ -44,6 +68,7 @@ N_INT = 16
 F_T, F_LAST_T, F_WARN_T, F_WARN_MOVED, F_WARN_SCALE = 0, 1, 2, 3, 4
 N_FLOAT = 5
 KMAX = 5  # highest derivative used to judge a tangency
+ROW_MAIN, ROW_PHASE = 0, 1  # a contactor's switching row; the end of its released phase
 
 
 @njit(cache=True, nogil=True)
@@ -55,17 +80,36 @@ def _dot(x, y):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _energy(mask, eta, deta, om, Wc, gap, side, kst):  # pragma: no cover - compiled
-    """Mechanical energy: beam, end supports and engaged contactors (with their gaps)."""
+def energy(mask, e, d, omo, Wc, gap, side, kst):  # pragma: no cover - compiled
+    """Mechanical energy from the modal frame: beam, end supports and engaged contactors (with their gaps)."""
     E = 0.0
-    for n in range(eta.size):
-        E += 0.5 * (deta[n] * deta[n] + om[n] * om[n] * eta[n] * eta[n])
+    for n in range(e.size):
+        E += 0.5 * (d[n] * d[n] + omo[n] * omo[n] * e[n] * e[n])
     for i in range(gap.size):
         if (mask >> i) & 1:
-            wc = _dot(Wc[i], eta)
+            wc = _dot(Wc[i], e)
             g = gap[i] - side[i] * wc
             E += 0.5 * kst[i] * (g * g - wc * wc)
     return E
+
+
+@njit(cache=True, nogil=True)
+def to_modal(gen, G, z, dz, alpha, e, d):  # pragma: no cover - compiled
+    """Modal-frame displacement ``e`` and velocity ``d`` of a slot's coordinates ``z, z'``."""
+    nm = z.size
+    if gen == 0:
+        e[:] = z
+        d[:] = dz
+        return
+    for m in range(nm):
+        se = 0.0
+        sd = 0.0
+        for n in range(nm):
+            r = dz[n] - alpha[n]
+            se += G[0, m, n] * z[n] + G[1, m, n] * r
+            sd += G[0, nm + m, n] * z[n] + G[1, nm + m, n] * r
+        e[m] = se
+        d[m] = sd
 
 
 @njit(cache=True, nogil=True)
@@ -77,9 +121,23 @@ def _find(keys, n, key):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _switch(fc, ic, eta, deta, smask, om, Wc, Tm, tr_from, tr_to, gap, side, kst,
-            ev_t, ev_kind, ev_c, ev_v, jumps, tol_h, work):  # pragma: no cover - compiled
-    """Switch contactor ``ic[I_PENDING]`` at ``fc[F_T]``; a status code if something is missing, else -1."""
+def load_value(kp, t, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
+    """The excitation's time law ``u(t)`` in piece ``kp``."""
+    tp = t - pt0[kp]
+    u = pconst[kp] + pslope[kp] * tp
+    if pamp[kp] != 0.0:
+        u += pamp[kp] * math.sin(pOm[kp] * tp + pphase[kp])
+    return u
+
+
+@njit(cache=True, nogil=True)
+def _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm, tr_from, tr_to,
+            gap, side, kst, dash, phase, u_now, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps, tol_h, work):
+    # pragma: no cover - compiled
+    """Switch contactor ``ic[I_PENDING]`` at ``fc[F_T]``; a status code if something is missing, else -1.
+
+    ``own_e, own_d`` hold the state in the current slot's modal frame.
+    """
     c = ic[I_PENDING]
     s = ic[I_SLOT]
     new_mask = smask[s] ^ (1 << c)
@@ -102,29 +160,49 @@ def _switch(fc, ic, eta, deta, smask, om, Wc, Tm, tr_from, tr_to, gap, side, kst
     t = fc[F_T]
     nc = gap.size
     nm = eta.size
-    E_before = _energy(smask[s], eta, deta, om[s], Wc[s], gap, side, kst)
+    E_before = energy(smask[s], own_e, own_d, omo[s], Wc[s], gap, side, kst)
+    engaging = (new_mask >> c) & 1
+    wb = work[0, :nc]
+    for i in range(nc):
+        wb[i] = _dot(Wc[s, i], own_e)
+    pen = side[c] * wb[c] - gap[c]
     if nev > 0 and ev_t[nev - 1] == t and ev_c[nev - 1] == c:
         ic[I_NEV] = nev - 1  # an impact and a rebound at one instant cancel (grazing touch)
     else:
         ev_t[nev] = t
-        ev_kind[nev] = 1 if (new_mask >> c) & 1 else 0
+        ev_kind[nev] = 1 if engaging else 0
         ev_c[nev] = c
-        ev_v[nev] = _dot(Wc[s, c], deta)
+        ev_v[nev] = _dot(Wc[s, c], own_d)
+        ev_d[nev] = pen
         ic[I_NEV] = nev + 1
-    wb = work[0, :nc]
-    for i in range(nc):
-        wb[i] = _dot(Wc[s, i], eta)
+    phase[c] = 1 if (not engaging and dash[c] > 0.0 and pen > tol_h) else 0
     e1 = work[1, :nm]
     d1 = work[2, :nm]
     T = Tm[k]
     for n in range(nm):
-        e1[n] = _dot(T[n], eta)
-        d1[n] = _dot(T[n], deta)
-    eta[:] = e1
-    deta[:] = d1
+        e1[n] = _dot(T[n], own_e)
+        d1[n] = _dot(T[n], own_d)
+    own_e[:] = e1
+    own_d[:] = d1
+    if gen[ns] == 0:
+        eta[:] = own_e
+        deta[:] = own_d
+    else:  # the new state's coordinates: z = H0 x, z' = H1 x + alpha(t)
+        for n in range(nm):
+            al = LW[ns, 1, n] * u_now + LW[ns, 3, n]
+            for i in range(nc):
+                if (new_mask >> i) & 1 and gap[i] != 0.0:
+                    al += side[i] * kst[i] * gap[i] * CW[ns, 1, i, n]
+            se = 0.0
+            sd = 0.0
+            for m in range(nm):
+                se += H[ns, 0, n, m] * own_e[m] + H[ns, 0, n, nm + m] * own_d[m]
+                sd += H[ns, 1, n, m] * own_e[m] + H[ns, 1, n, nm + m] * own_d[m]
+            eta[n] = se
+            deta[n] = sd + al
     lossy = False
     for i in range(nc):
-        moved = abs(_dot(Wc[ns, i], eta) - wb[i])
+        moved = abs(_dot(Wc[ns, i], own_e) - wb[i])
         scale = max(max(gap[i], abs(wb[i])), 1e6 * tol_h)  # floor 1e-6 L: zero gap at rest
         if moved > 0.05 * scale:
             if not (ic[I_WARN_N] or lossy) or moved / scale > fc[F_WARN_MOVED] / fc[F_WARN_SCALE]:
@@ -135,7 +213,7 @@ def _switch(fc, ic, eta, deta, smask, om, Wc, Tm, tr_from, tr_to, gap, side, kst
             lossy = True
     if lossy:
         ic[I_WARN_N] += 1
-    jumps[ic[I_NJUMP]] = _energy(new_mask, eta, deta, om[ns], Wc[ns], gap, side, kst) - E_before
+    jumps[ic[I_NJUMP]] = energy(new_mask, own_e, own_d, omo[ns], Wc[ns], gap, side, kst) - E_before
     ic[I_NJUMP] += 1
     ic[I_SLOT] = ns
     ic[I_JUST] = c
@@ -144,16 +222,49 @@ def _switch(fc, ic, eta, deta, smask, om, Wc, Tm, tr_from, tr_to, gap, side, kst
 
 
 @njit(cache=True, nogil=True)
-def _judge_start(ic, fc, g, V, base, dec, om, eta, deta, lA, lB, lD, Om, phi, toggles, tol_h, dvec, mag):
-    # pragma: no cover - compiled
-    """Contactor to switch at the segment start (inconsistent or departing into its stop), or -1."""
+def contactor_rows(s, mask, RW, gap, side, kst, dash, phase, V, U, base, rowc, rowk):  # pragma: no cover
+    """The switching rows of slot ``s`` (positive while the state holds); their number.
+
+    Free: the opening ``gap - s w`` (a released dashpot contactor: ``-F/k``,
+    and its penetration, whose return to 0 ends that phase). Engaged: the
+    penetration ``s w - gap``, or ``F / k = d + (c/k) d'`` with a dashpot.
+    """
+    nm = V.shape[1]
+    nr = 0
+    for c in range(gap.size):
+        eng = (mask >> c) & 1
+        sg = side[c] if eng else -side[c]
+        r = dash[c] / kst[c] if (eng or phase[c]) else 0.0
+        for n in range(nm):
+            V[nr, n] = sg * (RW[s, 0, c, n] + r * RW[s, 2, c, n])
+            U[nr, n] = sg * (RW[s, 1, c, n] + r * RW[s, 3, c, n])
+        base[nr] = -gap[c] if eng else gap[c]
+        rowc[nr] = c
+        rowk[nr] = ROW_MAIN
+        nr += 1
+        if not eng and phase[c]:
+            for n in range(nm):
+                V[nr, n] = side[c] * RW[s, 0, c, n]
+                U[nr, n] = side[c] * RW[s, 1, c, n]
+            base[nr] = -gap[c]
+            rowc[nr] = c
+            rowk[nr] = ROW_PHASE
+            nr += 1
+    return nr
+
+
+@njit(cache=True, nogil=True)
+def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD, lE, AL, Om, phi, toggles,
+                 tol_h, dvec, mag):  # pragma: no cover - compiled
+    """Row to act on at the segment start (inconsistent, or departing into its stop), or -1."""
     just = ic[I_JUST]
-    for c in range(g.size):
-        if g[c] > tol_h:
+    for r in range(nr):
+        if g[r] > tol_h:
             continue
-        bad = g[c] < -tol_h and c != just
+        c = rowc[r]
+        bad = g[r] < -tol_h and c != just
         if not bad:
-            bad = departure(V[c], base[c], dec, om, eta, deta, lA, lB, lD, Om, phi, dvec, mag) < 0
+            bad = departure(V[r], U[r], base[r], dec, om, eta, deta, lA, lB, lD, lE, AL, Om, phi, dvec, mag) < 0
         if bad:
             t = fc[F_T]
             if t != fc[F_LAST_T]:
@@ -161,32 +272,39 @@ def _judge_start(ic, fc, g, V, base, dec, om, eta, deta, lA, lB, lD, Om, phi, to
                 fc[F_LAST_T] = t
             toggles[c] += 1
             if toggles[c] <= 2:
-                return c
+                return r
     return -1
 
 
 @njit(cache=True, nogil=True)
-def run(reg, dec, wdh, om, Wc, pw, smask, Tm, tr_from, tr_to, gap, side, kst,
+def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, tr_to, gap, side, kst, dash,
         pt0, pt1, pconst, pslope, pamp, pOm, pphase,
-        T_end, tol_h, xtol, max_events, budget, fc, ic, eta, deta, toggles,
-        seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_v, jumps):
+        T_end, tol_h, xtol, max_events, budget, fc, ic, eta, deta, own_e, own_d, toggles, phase,
+        seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps):
     # pragma: no cover - compiled
     """Run (or resume) the event loop; returns a status code (module docstring)."""
     nm = eta.size
     nc = gap.size
-    h0, dh0, P, lA, lB, lD = workspace(nm)
-    V = np.empty((nc, nm))
-    base = np.empty(nc)
-    VH = np.empty((nc, nm))
-    VD = np.empty((nc, nm))
-    PV = np.empty((nc, 7))
-    g = np.empty(nc)
-    dg = np.empty(nc)
-    gb = np.empty(nc)
-    dgb = np.empty(nc)
-    M = np.empty(nc)
+    nrm = 2 * nc
+    h0, dh0, P, lA, lB, lD, lE, AL = workspace(nm)
+    V = np.empty((nrm, nm))
+    U = np.empty((nrm, nm))
+    base = np.empty(nrm)
+    rowc = np.empty(nrm, dtype=np.int64)
+    rowk = np.empty(nrm, dtype=np.int64)
+    VH = np.empty((nrm, nm))
+    VD = np.empty((nrm, nm))
+    WH = np.empty((nrm, nm))
+    WD = np.empty((nrm, nm))
+    PV = np.empty((nrm, NP))
+    g = np.empty(nrm)
+    dg = np.empty(nrm)
+    gb = np.empty(nrm)
+    dgb = np.empty(nrm)
+    M = np.empty(nrm)
     dvec = np.empty(KMAX + 1)
     mag = np.empty(KMAX + 1)
+    alpha = np.empty(nm)
     stack = np.empty((96, 6))
     work = np.empty((3, max(nm, nc)))
     evals = 0
@@ -197,8 +315,9 @@ def run(reg, dec, wdh, om, Wc, pw, smask, Tm, tr_from, tr_to, gap, side, kst,
                 fc[F_LAST_T] = t
                 toggles[:] = 0
                 ic[I_SAME] = 0
-            st = _switch(fc, ic, eta, deta, smask, om, Wc, Tm, tr_from, tr_to, gap, side, kst,
-                         ev_t, ev_kind, ev_c, ev_v, jumps, tol_h, work)
+            u_now = load_value(ic[I_PIECE], t, pt0, pconst, pslope, pamp, pOm, pphase) if ic[I_PIECE] < pt0.size else 0.0
+            st = _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm, tr_from, tr_to,
+                         gap, side, kst, dash, phase, u_now, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps, tol_h, work)
             if st >= 0:
                 return st
             ic[I_SAME] += 1
@@ -210,34 +329,42 @@ def run(reg, dec, wdh, om, Wc, pw, smask, Tm, tr_from, tr_to, gap, side, kst,
         if t >= T_end or kp >= pt0.size:
             return DONE
         s = ic[I_SLOT]
-        Om, phi = segment_setup(s, kp, t, eta, deta, reg, dec, om, pw, Wc, smask, gap, side, kst,
-                                pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD)
-        mask = smask[s]
-        for c in range(nc):
-            o = -1.0 if (mask >> c) & 1 else 1.0
-            base[c] = o * gap[c]
+        Om, phi = segment_setup(s, kp, t, eta, deta, reg, dec, om, LW[:, 0], LW[:, 1], CW[:, 0], CW[:, 1],
+                                LW[:, 2], LW[:, 3], smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
+                                h0, dh0, P, lA, lB, lD, lE, AL)
+        nr = contactor_rows(s, smask[s], RW, gap, side, kst, dash, phase, V, U, base, rowc, rowk)
+        t_end = min(pt1[kp], T_end)
+        tau_end = t_end - t
+        project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, nr)
+        for r in range(nr):
+            pv, pd = particular(PV[r], 0.0, Om, phi)
+            g[r] = base[r] + pv
+            dg[r] = pd
             for n in range(nm):
-                V[c, n] = -o * side[c] * Wc[s, c, n]
-            g[c] = base[c] + _dot(V[c], eta)
-            dg[c] = _dot(V[c], deta)
-        if ic[I_SKIP] == 0 and nc > 0:
-            c_bad = _judge_start(ic, fc, g, V, base, dec[s], om[s], eta, deta, lA, lB, lD, Om, phi,
-                                 toggles, tol_h, dvec, mag)
-            if c_bad >= 0:
-                ic[I_PENDING] = c_bad
+                g[r] += VH[r, n]
+                dg[r] += VD[r, n]
+        if ic[I_SKIP] == 0 and nr > 0:
+            r_bad = _judge_start(ic, fc, g, nr, rowc, V, U, base, dec[s], om[s], eta, deta, lA, lB, lD, lE, AL,
+                                 Om, phi, toggles, tol_h, dvec, mag)
+            if r_bad >= 0:
+                c = rowc[r_bad]
+                if rowk[r_bad] == ROW_PHASE:
+                    phase[c] = 0  # the penetration left by a release is gone: a plain opening from here
+                    continue
+                alpha_at(AL, 0.0, Om, phi, alpha)
+                to_modal(gen[s], G[s], eta, deta, alpha, own_e, own_d)
+                ic[I_PENDING] = c
                 continue
         if ic[I_NSEG] + 1 > seg_t0.size:
             return NEED_SPACE
-        t_end = min(pt1[kp], T_end)
-        tau_end = t_end - t
-        project(V, base, h0, dh0, P, VH, VD, PV, nc)
-        curvature_bound(V, dec[s], om[s], h0, dh0, PV, Om, tau_end, M)
+        curvature_bound(VH[:nr], VD[:nr], dec[s], om[s], PV[:nr], Om, tau_end, M[:nr])
         wmax = 0.0
         for n in range(nm):
             wmax = max(wmax, om[s, n])
         dmin = math.pi / (4.0 * wmax) if wmax > 0.0 else tau_end
-        tau_e, ch, used = scan(0.0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget - evals, stack,
-                               reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi, V, h0, dh0)
+        tau_e, ch, used = scan(0.0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h,
+                               budget - evals, stack, reg[s], dec[s], wdh[s], om[s], VH[:nr], VD[:nr], base[:nr],
+                               PV[:nr], Om, phi, WH[:nr], WD[:nr])
         evals += used
         ic[I_EVALS] += used
         te = t + tau_e if ch != -1 else t_end
@@ -254,7 +381,14 @@ def run(reg, dec, wdh, om, Wc, pw, smask, Tm, tr_from, tr_to, gap, side, kst,
         fc[F_T] = te
         ic[I_SKIP] = 0
         if ch >= 0:
-            ic[I_PENDING] = ch
+            c = rowc[ch]
+            if rowk[ch] == ROW_PHASE:
+                phase[c] = 0
+                ic[I_JUST] = -1
+            else:
+                alpha_at(AL, te - t, Om, phi, alpha)
+                to_modal(gen[s], G[s], eta, deta, alpha, own_e, own_d)
+                ic[I_PENDING] = c
         elif ch == -2:
             ic[I_JUST] = -1
             ic[I_SKIP] = 1

@@ -32,7 +32,8 @@ from ..modal import mode_set
 from . import _loop
 from ..model import Damping, SolverOptions
 from .solution import Event, Solution
-from .states import StateModel, StateSpace
+from .blocks import classical_slot, slot_arrays
+from .states import StateModel, StateSpace, _preload_key
 
 __all__ = ["integrate", "initial_coordinates", "pack"]
 
@@ -63,7 +64,7 @@ def initial_coordinates(beam: Beam, initial: InitialCondition, n_modes: int) -> 
     return eta, deta
 
 
-def make_space(beam, contactors, damping, excitation, options: SolverOptions, points) -> StateSpace:
+def make_space(beam, contactors, damping, excitation, options: SolverOptions, points, preload=None) -> StateSpace:
     """The state space of ``options.basis``: the paper's per-state modes or the shared Ritz basis.
 
     The shared basis needs a static attachment shape per contactor: the
@@ -76,7 +77,7 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
     if options.basis == "enriched" and (beam.is_uniform or not mode_set(beam, (), options.modes).n_rigid):
         from .ritz_space import RitzStateSpace
 
-        return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points)  # type: ignore[return-value]
+        return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points, preload)  # type: ignore[return-value]
     if options.basis == "enriched" and contactors:
         from .._warnings import emit_user_level_warning
 
@@ -85,7 +86,7 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
             "masses or springs, or Timoshenko) can move as a rigid body; using the paper's per-state modes "
             '(solver.basis = "paper"), which need more modes for stiff contactors'
         )
-    return StateSpace(beam, contactors, damping, excitation, options.modes, points)
+    return StateSpace(beam, contactors, damping, excitation, options.modes, points, preload)
 
 
 def space_initial_coordinates(space, beam: Beam, initial: InitialCondition, n_modes: int):
@@ -119,7 +120,14 @@ def _grow(a: np.ndarray, n: int) -> np.ndarray:
 
 
 class _Packed:
-    """The visited states of one problem in arrays for the compiled loop (grown on demand)."""
+    """The visited states of one problem in arrays for the compiled loop (grown on demand).
+
+    Per slot, the arrays of :class:`~impactbeam.solver.blocks.SlotArrays`
+    (see :mod:`~impactbeam.solver._loop`), the modal-frame frequencies
+    ``omo``, shapes at the contactors ``Wc`` and load weights ``pw``, ``pre``.
+    """
+
+    _PER_SLOT = ("reg", "dec", "wdh", "om", "omo", "Wc", "pw", "pre", "LW", "CW", "RW", "gen", "G", "H", "Cd")
 
     def __init__(self, space: StateSpace, preserve: bool) -> None:
         self.space = space
@@ -132,9 +140,19 @@ class _Packed:
         self.dec = np.zeros((cap, nm))
         self.wdh = np.zeros((cap, nm))
         self.om = np.zeros((cap, nm))
+        self.omo = np.zeros((cap, nm))
         self.Wc = np.zeros((cap, nc, nm))
         self.pw = np.zeros((cap, nm))
+        self.pre = np.zeros((cap, nm))
+        self.LW = np.zeros((cap, 4, nm))
+        self.CW = np.zeros((cap, 2, nc, nm))
+        self.RW = np.zeros((cap, 4, nc, nm))
+        self.gen = np.zeros(cap, dtype=np.int64)
+        self.G = np.zeros((cap, 2, 2 * nm, nm))
+        self.H = np.zeros((cap, 2, nm, 2 * nm))
+        self.Cd = np.zeros((cap, nm, nm))
         self.smask = np.full(cap, -1, dtype=np.int64)
+        self.dash = np.ascontiguousarray(space.dashpots, dtype=float)
         self.models: list[StateModel] = []
         self.keys: list[tuple[int, ...]] = []
         self.Tm = np.zeros((4, nm, nm))
@@ -143,6 +161,11 @@ class _Packed:
         self.ntr = 0
         self._rows: dict[bytes, np.ndarray] = {}
         self.add_state(0)
+
+    @property
+    def general(self) -> bool:
+        """Whether any built state has a damping matrix its modes do not diagonalise."""
+        return bool(np.any(self.gen[: self.nslots]))
 
     def rows(self, x: np.ndarray) -> np.ndarray:
         """Mode shapes of every built state at ``x``: (n_states, len(x), n_modes), cached."""
@@ -160,6 +183,10 @@ class _Packed:
     def nslots(self) -> int:
         return len(self.models)
 
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """The per-slot arrays in the order of :data:`_PER_SLOT`."""
+        return tuple(getattr(self, name) for name in self._PER_SLOT)
+
     def add_state(self, mask: int) -> int:
         """Build the state with engaged-contactor bit mask ``mask``; its slot."""
         key = tuple(i for i in range(len(self.space.contactors)) if (mask >> i) & 1)
@@ -169,16 +196,21 @@ class _Packed:
         s = self.nslots
         if s >= self.smask.size:
             n = 2 * self.smask.size
-            for name in ("reg", "dec", "wdh", "om", "Wc", "pw"):
+            for name in self._PER_SLOT:
                 setattr(self, name, _grow(getattr(self, name), n))
             self.smask = np.concatenate([self.smask, np.full(n - s, -1, dtype=np.int64)])
-        dyn = st.dyn
-        self.reg[s] = np.where(dyn.under, 0, np.where(dyn.over, 2, 1))
-        self.dec[s] = dyn.decay
-        self.wdh[s] = np.where(dyn.under, dyn.wd, dyn.wh)
-        self.om[s] = st.modes.omega
+        omega = st.modes.omega
+        if st.damping_matrix is None:
+            sa = classical_slot(omega, st.dyn.decay, st.W_contact, st.load_weights, st.preload_weights)
+        else:
+            sa = slot_arrays(omega, st.damping_matrix, st.W_contact, st.load_weights, st.preload_weights)
+        for name in ("reg", "dec", "wdh", "om", "LW", "CW", "RW", "G", "H", "Cd"):
+            getattr(self, name)[s] = getattr(sa, name)
+        self.gen[s] = sa.gen
+        self.omo[s] = omega
         self.Wc[s] = st.W_contact
         self.pw[s] = st.load_weights
+        self.pre[s] = st.preload_weights
         self.smask[s] = mask
         self.models.append(st)
         self.keys.append(key)
@@ -204,19 +236,21 @@ def pack(
     damping: Damping,
     excitation: Excitation,
     options: SolverOptions,
+    preload: Excitation | None = None,
 ) -> _Packed:
     """The packed problem, from the cache when its modes and transfers are already known."""
     key = (
-        beam, tuple((c.position, c.stiffness) for c in contactors), damping, excitation.kind,
-        excitation.position, options.modes, options.projection, options.basis,
+        beam, tuple((c.position, c.stiffness, c.damping, c.restitution) for c in contactors), damping,
+        excitation.kind, excitation.position, options.modes, options.projection, options.basis,
+        _preload_key(preload),
     )
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
         return hit
     # gaps and sides enter the compiled loop directly: the states do not depend on them
-    neutral = tuple(Contactor(c.position, c.stiffness, 0.0, "below") for c in contactors)
-    space = make_space(beam, neutral, damping, excitation, options, np.zeros(0))
+    neutral = tuple(Contactor(c.position, c.stiffness, 0.0, "below", c.damping, c.restitution) for c in contactors)
+    space = make_space(beam, neutral, damping, excitation, options, np.zeros(0), preload)
     packed = _Packed(space, options.projection == "contact")
     _CACHE[key] = packed
     if len(_CACHE) > _CACHE_SIZE:
@@ -239,6 +273,7 @@ class _Records:
         self.ev_kind = np.empty(n, dtype=np.int64)
         self.ev_c = np.empty(n, dtype=np.int64)
         self.ev_v = np.empty(n)
+        self.ev_d = np.empty(n)
         self.jumps = np.empty(n)
 
     def grow(self, ic: np.ndarray) -> None:
@@ -248,7 +283,7 @@ class _Records:
                 setattr(self, name, _grow(getattr(self, name), n))
         if ic[_loop.I_NEV] + 1 > self.ev_t.size or ic[_loop.I_NJUMP] + 1 > self.jumps.size:
             n = 2 * max(self.ev_t.size, self.jumps.size)
-            for name in ("ev_t", "ev_kind", "ev_c", "ev_v", "jumps"):
+            for name in ("ev_t", "ev_kind", "ev_c", "ev_v", "ev_d", "jumps"):
                 setattr(self, name, _grow(getattr(self, name), n))
 
 
@@ -268,14 +303,14 @@ def _pieces(excitation: Excitation, end_time: float) -> tuple[np.ndarray, ...]:
 
 
 def _call(pk: _Packed, con: tuple[np.ndarray, ...], pcs: tuple[np.ndarray, ...], opt: SolverOptions, tol_h: float,
-          fc: np.ndarray, ic: np.ndarray, eta: np.ndarray, deta: np.ndarray, toggles: np.ndarray,
-          rec: _Records) -> int:
+          fc: np.ndarray, ic: np.ndarray, carry: tuple[np.ndarray, ...], rec: _Records) -> int:
     try:
         return int(_loop.run(
-            pk.reg, pk.dec, pk.wdh, pk.om, pk.Wc, pk.pw, pk.smask, pk.Tm, pk.tr_from, pk.tr_to, *con, *pcs,
+            pk.reg, pk.dec, pk.wdh, pk.om, pk.omo, pk.Wc, pk.LW, pk.CW, pk.RW, pk.gen, pk.G, pk.H, pk.smask, pk.Tm,
+            pk.tr_from, pk.tr_to, *con, pk.dash, *pcs,
             float(opt.end_time), tol_h, float(opt.event_tolerance), int(opt.max_events), _BUDGET,
-            fc, ic, eta, deta, toggles, rec.seg_t0, rec.seg_t1, rec.seg_s, rec.seg_k, rec.seg_eta, rec.seg_deta,
-            rec.ev_t, rec.ev_kind, rec.ev_c, rec.ev_v, rec.jumps,
+            fc, ic, *carry, rec.seg_t0, rec.seg_t1, rec.seg_s, rec.seg_k, rec.seg_eta, rec.seg_deta,
+            rec.ev_t, rec.ev_kind, rec.ev_c, rec.ev_v, rec.ev_d, rec.jumps,
         ))
     except SystemError as exc:  # a signal that arrived while numba converted the arguments
         if isinstance(exc.__cause__ or exc.__context__, KeyboardInterrupt):
@@ -292,6 +327,7 @@ def integrate(
     options: SolverOptions,
     progress: Callable[[float], None] | None = None,
     start: tuple[np.ndarray, np.ndarray] | None = None,
+    preload: Excitation | None = None,
 ) -> Solution:
     """Run the exact event-driven integration; see :func:`impactbeam.simulate`.
 
@@ -309,6 +345,8 @@ def integrate(
     start : tuple of ndarray, optional
         Free-state modal displacement and velocity at t = 0 (replaces
         ``initial``); see :meth:`Solution.modal_state`.
+    preload : Excitation, optional
+        A constant load acting throughout (kind, position, amplitude).
 
     Returns
     -------
@@ -317,7 +355,7 @@ def integrate(
     """
     contactors = tuple(contactors)
     _announce_compile()
-    pk = pack(beam, contactors, damping, excitation, options)
+    pk = pack(beam, contactors, damping, excitation, options, preload)
     nm = pk.n_modes
     con = (
         np.array([c.gap for c in contactors], dtype=float),
@@ -338,12 +376,14 @@ def integrate(
             raise ValueError(f"start: expected two arrays of {nm} modal coordinates")
     eta = np.ascontiguousarray(eta, dtype=float)
     deta = np.ascontiguousarray(deta, dtype=float)
-    toggles = np.zeros(max(len(contactors), 1), dtype=np.int64)
+    nc1 = max(len(contactors), 1)
+    # slot coordinates, the state in the modal frame at a pending switch, toggles and released phases
+    carry = (eta, deta, eta.copy(), deta.copy(), np.zeros(nc1, dtype=np.int64), np.zeros(nc1, dtype=np.int64))
     rec = _Records(nm)
     while True:
         ic[_loop.I_NSLOTS] = pk.nslots
         ic[_loop.I_NTR] = pk.ntr
-        status = _call(pk, con, pcs, options, tol_h, fc, ic, eta, deta, toggles, rec)
+        status = _call(pk, con, pcs, options, tol_h, fc, ic, carry, rec)
         if status == _loop.NEED_STATE:
             pk.add_state(int(ic[_loop.REQ_A]))
         elif status == _loop.NEED_TRANSFER:
@@ -390,7 +430,8 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solutio
         t0=rec.seg_t0[:nseg].copy(), t1=rec.seg_t1[:nseg].copy(), slot=rec.seg_s[:nseg].copy(),
         piece=rec.seg_k[:nseg].copy(), eta0=rec.seg_eta[:nseg].copy(), deta0=rec.seg_deta[:nseg].copy(),
         packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=events,
-        energy_jumps=rec.jumps[:njump].copy(), status=code, message=message, warnings=tuple(warnings),
+        energy_jumps=rec.jumps[:njump].copy(), event_penetrations=rec.ev_d[:nev].copy(), status=code,
+        message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
         n_modes=pk.n_modes,
     )

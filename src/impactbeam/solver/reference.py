@@ -157,12 +157,14 @@ class _Reference:
         damping: Damping,
         excitation: Excitation,
         options: SolverOptions,
+        preload: Excitation | None = None,
     ) -> None:
         self.beam = beam
         self.contactors = contactors
         self.excitation = excitation
         self.opt = options
-        self.space = make_space(beam, contactors, damping, excitation, options, np.zeros(0))
+        self.space = make_space(beam, contactors, damping, excitation, options, np.zeros(0), preload)
+        self.dash = np.asarray(self.space.dashpots, dtype=float)
         self.gap = np.array([c.gap for c in contactors], dtype=float)
         self.side = np.array([c.direction for c in contactors], dtype=float)
         self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
@@ -184,6 +186,51 @@ class _Reference:
         for i in st.engaged:
             f += self.side[i] * self.stiff[i] * self.gap[i] * st.W_contact[i]
         return f
+
+    def first_order(self, st: StateModel) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, f)`` of the state's first-order system ``y' = A y + b u(t) + f``, ``y = (eta, eta')``."""
+        n = st.modes.count
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -np.diag(st.modes.omega**2)
+        A[n:, n:] = -self.damping_matrix(st)
+        return A, np.concatenate([np.zeros(n), self.gap_force(st) + st.preload_weights])
+
+    def damping_matrix(self, st: StateModel) -> np.ndarray:
+        """The state's damping in its modal frame (the beam's model and the engaged dashpots)."""
+        return st.damping_matrix if st.damping_matrix is not None else np.diag(2.0 * st.dyn.decay)
+
+    def events(self, st: StateModel, engaged: tuple[int, ...], phase: list[bool]) -> tuple[list, list]:
+        """Terminal event functions, positive while the state holds, and what each row is.
+
+        Engaged: the penetration ``d = s w - gap``, or with a dashpot the force
+        over the stiffness ``d + (c/k) d'``; free: the opening ``gap - s w``,
+        or after a release that left a penetration ``-(d + (c/k) d')`` and
+        the penetration itself (whose return to 0 ends that phase).
+        """
+        n = st.modes.count
+        evs, rows = [], []
+
+        def make(Wc, base, sign, r):
+            def ev(tt, y):
+                return base + sign * (float(Wc @ y[:n]) + r * float(Wc @ y[n:]))
+
+            ev.terminal = True
+            ev.direction = -1.0
+            return ev
+
+        for c in range(len(self.contactors)):
+            Wc, g0, s0 = st.W_contact[c], self.gap[c], self.side[c]
+            r = self.dash[c] / self.stiff[c]
+            if c in engaged:
+                evs.append(make(Wc, -g0, s0, r))
+            else:
+                evs.append(make(Wc, g0, -s0, r if phase[c] else 0.0))
+            rows.append((c, "main"))
+            if c not in engaged and phase[c]:
+                evs.append(make(Wc, -g0, s0, 0.0))
+                rows.append((c, "phase"))
+        return evs, rows
 
     def energy(self, st: StateModel, eta: np.ndarray, deta: np.ndarray) -> float:
         """Kinetic + strain (beam, supports) + engaged contactor springs ``1/2 k g^2``."""
@@ -232,6 +279,8 @@ class _Reference:
         status, message = 0, "The simulation reached end_time."
         nc = len(self.contactors)
         same_instant: dict[int, int] = {}
+        phase = [False] * nc  # released with a penetration left (dashpot contactors)
+        pens: list[float] = []
         last_t = -1.0
         atol_state: dict[tuple[int, ...], np.ndarray] = {}
         while t < T:
@@ -241,34 +290,14 @@ class _Reference:
             a_int = breaks[k_break - 1] if k_break > 0 else 0.0
             st = self.space.state(engaged)
             n = st.modes.count
-            om2 = st.modes.omega**2
-            c2 = 2.0 * st.dyn.decay
-            p = st.load_weights
-            fgap = self.gap_force(st)
             u = _history_on(self.excitation, a_int, t_stop)
-
-            # first-order form y' = A y + b u(t) + f: y = (eta, eta')
-            A = np.zeros((2 * n, 2 * n))
-            A[:n, n:] = np.eye(n)
-            A[n:, :n] = -np.diag(om2)
-            A[n:, n:] = -np.diag(c2)
-            bvec = np.concatenate([np.zeros(n), p])
-            fvec = np.concatenate([np.zeros(n), fgap])
+            A, fvec = self.first_order(st)  # y' = A y + b u(t) + f, y = (eta, eta')
+            bvec = np.concatenate([np.zeros(n), st.load_weights])
 
             def rhs(tt, y, A=A, bvec=bvec, fvec=fvec, u=u):
                 return A @ y + bvec * u(tt) + fvec
 
-            evs = []
-            for c in range(nc):
-                Wc = st.W_contact[c]
-                g0, s0 = self.gap[c], self.side[c]
-
-                def ev(tt, y, Wc=Wc, g0=g0, s0=s0, n=n):
-                    return g0 - s0 * float(Wc @ y[:n])
-
-                ev.terminal = True
-                ev.direction = 1.0 if c in engaged else -1.0
-                evs.append(ev)
+            evs, rows = self.events(st, engaged, phase)
             y0 = np.concatenate([eta, deta])
             if engaged not in atol_state:
                 atol_state[engaged] = self.atol(st, y0)
@@ -280,16 +309,18 @@ class _Reference:
                 raise SimulationError(f"solve_ivp failed at t = {t:.9g} s: {sol.message}")
             hit: tuple[float, int] | None = None
             if sol.status == 1:
-                for c, te in enumerate(sol.t_events):
+                for r, te in enumerate(sol.t_events):
                     if te.size and (hit is None or te[0] < hit[0]):
-                        hit = (float(te[0]), c)
+                        hit = (float(te[0]), r)
             t1 = hit[0] if hit is not None else float(sol.t[-1])
             y1 = sol.sol(t1) if sol.sol is not None else y0
             segments.append(IvpSegment(t, t1, engaged, IvpDense(sol.sol, t, t1, y0, y1)))
             eta, deta = y1[:n].copy(), y1[n:].copy()
             t = t1
-            if hit is not None:
-                c = hit[1]
+            if hit is not None and rows[hit[1]][1] == "phase":
+                phase[rows[hit[1]][0]] = False  # the penetration left by a release is gone
+            elif hit is not None:
+                c = rows[hit[1]][0]
                 if t != last_t:
                     same_instant, last_t = {}, t
                 same_instant[c] = same_instant.get(c, 0) + 1
@@ -298,8 +329,12 @@ class _Reference:
                 E_before = self.energy(st, eta, deta)
                 if events and events[-1].time == t and events[-1].contactor == c:
                     events.pop()  # an impact and a rebound at one instant cancel (grazing touch)
+                    pens.pop()
                 else:
                     events.append(Event(t, kind, c, float(st.W_contact[c] @ deta)))
+                    pens.append(self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c])
+                pen = self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c]
+                phase[c] = kind == "rebound" and self.dash[c] > 0.0 and pen > 1e-12 * self.beam.length
                 P = self.space.transfer(new, engaged, self.opt.projection == "contact")
                 eta, deta = P @ eta, P @ deta
                 engaged = new
@@ -314,7 +349,7 @@ class _Reference:
                     )
                     break
         return IvpSolution(self, segments, events, np.asarray(jumps, dtype=float), status, message,
-                           t if status else T)
+                           t if status else T, np.asarray(pens, dtype=float))
 
 
 
@@ -326,16 +361,18 @@ class IvpSolution(PiecewiseSolution):
     integrals by 8-point Gauss-Legendre on sub-intervals of a quarter period.
     """
 
-    def __init__(self, ref: _Reference, segments, events, jumps, status, message, t_end) -> None:
+    def __init__(self, ref: _Reference, segments, events, jumps, status, message, t_end, penetrations) -> None:
         self.ref = ref
         self.segments = segments
         self.events = events
         self.energy_jumps = jumps
+        self.event_penetrations = penetrations
         self.status = status
         self.message = message
         self.warnings = ()
         self.t_end = t_end
         self.contactors = ref.contactors
+        self.dashpots = ref.dash
         self.n_modes = ref.space.state(()).modes.count
         self._t0 = np.array([seg.t0 for seg in segments])
         self._h = ref.max_step / 8.0
@@ -349,7 +386,7 @@ class IvpSolution(PiecewiseSolution):
         nt, nm, nc = t.size, self.n_modes, len(self.contactors)
         w, w_t = np.full((nt, x.size), np.nan), np.full((nt, x.size), np.nan)
         eng = np.zeros((nt, nc), dtype=bool)
-        eta, eta_t, en = np.full((nt, nm), np.nan), np.full((nt, nm), np.nan), np.full((nt, 4), np.nan)
+        eta, eta_t, en = np.full((nt, nm), np.nan), np.full((nt, nm), np.nan), np.full((nt, 5), np.nan)
         idx = self._index(t)
         for j in np.unique(idx):
             seg = self.segments[j]
@@ -367,8 +404,12 @@ class IvpSolution(PiecewiseSolution):
                 u = self.ref.excitation.history(t[sel])
                 en[sel, 0] = 0.5 * np.sum(d**2, axis=0)
                 en[sel, 1] = 0.5 * np.sum((st.modes.omega[:, None] * e) ** 2, axis=0)
-                en[sel, 2] = u * (st.load_weights @ d)
-                en[sel, 3] = np.sum((2.0 * st.dyn.decay)[:, None] * d**2, axis=0)
+                en[sel, 2] = u * (st.load_weights @ d) + st.preload_weights @ d
+                total = np.einsum("it,ij,jt->t", d, self.ref.damping_matrix(st), d)
+                vc = st.W_contact[list(seg.engaged)] @ d
+                dash = np.sum(self.ref.dash[list(seg.engaged)][:, None] * vc**2, axis=0)
+                en[sel, 3] = total - dash
+                en[sel, 4] = dash
         return Samples(w, w_t, eng, eta if modal else None, eta_t if modal else None, en if energy else None)
 
     def _pieces(self, lo: float, hi: float, engaged: int | None):
@@ -377,14 +418,25 @@ class IvpSolution(PiecewiseSolution):
             if b >= a and (engaged is None or engaged in seg.engaged):
                 yield seg, a, b
 
-    def extremum(self, x, lo, hi, sign=1.0, offset=0.0, engaged=None):
+    def extremum(self, x, lo, hi, sign=1.0, offset=0.0, engaged=None, rate=0.0):
         best, tbest = -np.inf, np.nan
         for seg, a, b in self._pieces(lo, hi, engaged):
-            W = self.ref.space.state(seg.engaged).modes.shapes([x])[:, 0]
+            st = self.ref.space.state(seg.engaged)
+            W = st.modes.shapes([x])[:, 0]
+            f0 = np.concatenate([np.zeros(st.modes.count), st.load_weights])
+            A, fc = self.ref.first_order(st)
 
-            def u(tt, seg=seg, W=W):
-                e, d = seg.solution.evaluate(np.atleast_1d(tt) - seg.t0)
-                return sign * (W @ e + offset), sign * (W @ d)
+            def u(tt, seg=seg, W=W, A=A, fc=fc, f0=f0):
+                tt = np.atleast_1d(tt)
+                e, d = seg.solution.evaluate(tt - seg.t0)
+                val = W @ e + offset
+                der = W @ d
+                if rate:
+                    n = e.shape[0]
+                    acc = (A @ np.vstack([e, d]) + fc[:, None] + np.outer(f0, self.ref.excitation.history(tt)))[n:]
+                    val = val + rate * der
+                    der = der + rate * (W @ acc)
+                return sign * val, sign * der
 
             ts = np.linspace(a, b, max(3, int(math.ceil((b - a) / self._h)) + 1))
             val, der = u(ts)
@@ -421,6 +473,7 @@ def integrate_ivp(
     excitation: Excitation,
     initial: InitialCondition,
     options: SolverOptions,
+    preload: Excitation | None = None,
 ) -> IvpSolution:
     """Integrate the modal model with :func:`scipy.integrate.solve_ivp` and terminal events.
 
@@ -429,12 +482,14 @@ def integrate_ivp(
     beam : Beam
     contactors : tuple of Contactor
     damping : Damping
-        Modal damping ratios of the free and contact states.
+        The beam's damping model; contactor dashpots come with the contactors.
     excitation : Excitation
     initial : InitialCondition
     options : SolverOptions
         ``modes``, ``time_step`` (output sampling only), ``end_time``,
         ``max_events`` (chattering guard, status 1).
+    preload : Excitation, optional
+        A constant load acting throughout.
 
     Returns
     -------
@@ -458,6 +513,6 @@ def integrate_ivp(
     and what is not (propagation, load evaluation, event detection and
     location).
     """
-    ref = _Reference(beam, tuple(contactors), damping, excitation, options)
+    ref = _Reference(beam, tuple(contactors), damping, excitation, options, preload)
     eta, deta = space_initial_coordinates(ref.space, beam, initial, options.modes)
     return ref.run(eta, deta)

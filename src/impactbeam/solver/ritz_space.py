@@ -24,7 +24,7 @@ from ..model import Damping
 from ..model.beam import Beam, Contactor
 from ..model.loading import Excitation, InitialCondition, spatial_projection
 from .ritz import RitzBasis, ritz_basis
-from .states import ModalDynamics, ProblemSpace, StateModel
+from .states import ProblemSpace, StateModel
 
 __all__ = ["RitzModes", "RitzStateSpace"]
 
@@ -144,8 +144,9 @@ class RitzStateSpace(ProblemSpace):
         excitation: Excitation,
         n_modes: int,
         points: np.ndarray,
+        preload: Excitation | None = None,
     ) -> None:
-        super().__init__(beam, contactors, damping, excitation, n_modes, points)
+        super().__init__(beam, contactors, damping, excitation, n_modes, points, preload)
         for i, c in enumerate(self.contactors):
             if not math.isfinite(c.stiffness):
                 raise ParameterError(
@@ -157,6 +158,7 @@ class RitzStateSpace(ProblemSpace):
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
         self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length,
                                      self.basis.inertia)
+        self._pre = self._preload_weights(self.basis.values, self.basis.integral, self.basis.inertia)
 
     @property
     def count(self) -> int:
@@ -167,17 +169,24 @@ class RitzStateSpace(ProblemSpace):
         """The state with the contactors ``engaged`` (cached)."""
         st = self._states.get(engaged)
         if st is None:
-            springs = [(i, self.contactors[i].stiffness) for i in engaged]
-            omega, Phi = _state_eigen(self.basis, springs, self._psi_c)
+            omega, Phi = self._eigen(engaged)
             ms = RitzModes(self.basis, Phi, omega)
             n = ms.count
-            dyn = ModalDynamics(omega, self.damping.decay_rates(bool(engaged), omega))
             Wc = np.ascontiguousarray((Phi.T @ self._psi_c).T) if self.contactors else np.zeros((0, n))
             Wo = np.ascontiguousarray((Phi.T @ self._psi_o).T) if self.points.size else np.zeros((0, n))
-            p = Phi.T @ self._p
-            st = StateModel(engaged, ms, dyn, Wc, Wo, p)  # type: ignore[arg-type]
+            dyn, C = self._dynamics(engaged, omega, Wc, lambda: Phi.T @ self.state(()).modes.Phi)
+            st = StateModel(engaged, ms, dyn, Wc, Wo, Phi.T @ self._p, Phi.T @ self._pre, C)  # type: ignore[arg-type]
             self._states[engaged] = st
         return st
+
+    def _eigen(self, engaged: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+        springs = [(i, self.contactors[i].stiffness) for i in engaged]
+        return _state_eigen(self.basis, springs, self._psi_c)
+
+    def undamped(self, engaged: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+        omega, Phi = self._eigen(engaged)
+        Wc = np.ascontiguousarray((Phi.T @ self._psi_c).T) if self.contactors else np.zeros((0, omega.size))
+        return omega, Wc
 
     def projection(self, to: tuple[int, ...], frm: tuple[int, ...]) -> np.ndarray:
         """The exact change of coordinates ``Phi_to^T Phi_from`` (replaces eq. 12)."""

@@ -94,8 +94,10 @@ class Samples:
         Contactors engaged.
     eta, eta_t : ndarray or None, (n_t, n_modes)
         Modal coordinates in the basis of the state at each time (when asked for).
-    energies : ndarray or None, (n_t, 4)
-        Kinetic energy, modal strain energy, load power, damping power (when asked for).
+    energies : ndarray or None, (n_t, 5)
+        Kinetic energy, modal strain energy, load power (excitation and
+        preload), power dissipated by the beam's damping and by the engaged
+        contactors' dashpots (when asked for).
     """
 
     w: np.ndarray
@@ -118,12 +120,17 @@ class PiecewiseSolution:
     warnings : tuple of str
         What the solver is unsure of (e.g. a lossy projection at a switch).
     energy_jumps : ndarray, [J]
-        Change of mechanical energy at each switch (zero for a lossless one).
+        Change of mechanical energy at each switch (zero for a lossless one;
+        a contactor's dashpot releasing with a penetration left loses its
+        spring's energy there).
     t_end : float, [s]
         Where the solution ends (``end_time`` unless stopped).
+    dashpots : ndarray, (n_contactors,), [N s/m]
+        Each contactor's dashpot (``contactors.N.damping`` or from ``restitution``).
     """
 
     events: list[Event]
+    dashpots: np.ndarray
     status: int
     message: str
     warnings: tuple[str, ...]
@@ -131,6 +138,27 @@ class PiecewiseSolution:
     t_end: float
     contactors: tuple[Contactor, ...]
     n_modes: int
+
+    event_penetrations: np.ndarray
+
+    def release_losses(self) -> tuple[np.ndarray, np.ndarray]:
+        """Times and energies [J] a contactor's dashpot takes at its switches.
+
+        A contactor with a dashpot releases when ``k d + c d' = 0`` with a
+        penetration ``d > 0`` left: the energy ``k d^2 / 2`` of its spring
+        leaves the beam's mechanical energy there (the massless contact
+        element relaxes through its dashpot); when it engages again before
+        ``d`` returns to 0, ``k d^2 / 2`` comes back (a negative loss).
+        Without a dashpot ``d = 0`` at every switch and nothing is lost.
+        """
+        times, losses = [], []
+        for ev, d in zip(self.events, self.event_penetrations):
+            c = self.dashpots[ev.contactor] if len(self.dashpots) else 0.0
+            if c > 0.0 and d > 0.0:
+                e = 0.5 * self.contactors[ev.contactor].stiffness * d * d
+                times.append(ev.time)
+                losses.append(e if ev.kind == "rebound" else -e)
+        return np.asarray(times, dtype=float), np.asarray(losses, dtype=float)
 
     def check_times(self, t: Any, end_time: float, name: str = "t") -> np.ndarray:
         """Times as a float array; ParameterError outside ``[0, end_time]``.
@@ -170,8 +198,8 @@ class PiecewiseSolution:
         raise NotImplementedError
 
     def extremum(self, x: float, lo: float, hi: float, sign: float = 1.0, offset: float = 0.0,
-                 engaged: int | None = None) -> tuple[float, float]:
-        """Maximum of ``sign (w(x, t) + offset)`` over ``[lo, hi]`` and its time.
+                 engaged: int | None = None, rate: float = 0.0) -> tuple[float, float]:
+        """Maximum of ``sign (w(x, t) + rate w_t(x, t) + offset)`` over ``[lo, hi]`` and its time.
 
         With ``engaged = c`` only the times when contactor ``c`` is engaged count.
         Returns ``(-inf, nan)`` when no time qualifies.
@@ -188,6 +216,8 @@ class PiecewiseSolution:
             Added to ``w``.
         engaged : int or None
             Only times when this contactor is engaged.
+        rate : float, [s]
+            Weight of the velocity (a dashpot's force over the spring's: ``c / k``).
         """
         raise NotImplementedError
 
@@ -204,12 +234,12 @@ class PiecewiseSolution:
         raise NotImplementedError
 
     def extrema(self, queries: list[tuple]) -> np.ndarray:
-        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged)``: array (n, 2).
+        """Several :meth:`extremum` queries ``(x, lo, hi, sign, offset, engaged[, rate])``: array (n, 2).
 
         Parameters
         ----------
         queries : list of tuple
-            Each ``(x, lo, hi, sign, offset, engaged)`` as for :meth:`extremum`.
+            Each ``(x, lo, hi, sign, offset, engaged[, rate])`` as for :meth:`extremum`.
         """
         return np.array([self.extremum(*q) for q in queries], dtype=float).reshape(len(queries), 2)
 
@@ -248,6 +278,8 @@ class Solution(PiecewiseSolution):
     events : list of Event
     energy_jumps : ndarray, [J]
         Change of mechanical energy at each switch.
+    event_penetrations : ndarray, [m]
+        The switching contactor's penetration ``s w(a) - gap`` at each event.
     status : int
         0: reached ``end_time``; 1: stopped by the chattering guard.
     message : str
@@ -261,7 +293,8 @@ class Solution(PiecewiseSolution):
     """
 
     def __init__(self, *, t0, t1, slot, piece, eta0, deta0, packed, pieces, contactor_arrays, contactors,
-                 events, energy_jumps, status, message, warnings, t_end, evaluations, n_modes) -> None:
+                 events, energy_jumps, event_penetrations, status, message, warnings, t_end, evaluations,
+                 n_modes) -> None:
         self.t0 = t0
         self.t1 = t1
         self.slot = slot
@@ -274,12 +307,14 @@ class Solution(PiecewiseSolution):
         self.contactors = contactors
         self.events = events
         self.energy_jumps = energy_jumps
+        self.event_penetrations = event_penetrations
         self.status = status
         self.message = message
         self.warnings = warnings
         self.t_end = t_end
         self.evaluations = evaluations
         self.n_modes = n_modes
+        self.dashpots = packed.dash
         self._atol = 1e-12 * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
 
@@ -297,9 +332,10 @@ class Solution(PiecewiseSolution):
         """
         return self.packed.keys[int(self.slot[j])]
 
-    def _arrays(self) -> tuple:
+    def _model(self) -> tuple:
+        """The model arrays of :func:`~impactbeam.solver._dense.extremum` and ``integral``."""
         pk = self.packed
-        return (pk.reg, pk.dec, pk.wdh, pk.om, pk.pw, pk.Wc, pk.smask, *self.contactor_arrays,
+        return (pk.reg, pk.dec, pk.wdh, pk.om, pk.LW, pk.CW, pk.gen, pk.G, pk.smask, *self.contactor_arrays,
                 self.pieces[0], *self.pieces[2:])
 
     def rows(self, x: np.ndarray) -> np.ndarray:
@@ -337,10 +373,13 @@ class Solution(PiecewiseSolution):
         w_t = np.empty((nt, nx))
         eta = np.empty((nt, nm)) if modal else np.empty((0, nm))
         eta_t = np.empty((nt, nm)) if modal else np.empty((0, nm))
-        en = np.empty((nt, 4)) if energy else np.empty((0, 4))
+        en = np.empty((nt, 5)) if energy else np.empty((0, 5))
         if nt and self.n_segments:
+            pk = self.packed
             _dense.sample(t, idx, self.rows(x), w, w_t, eta, eta_t, en, modal, energy,
-                          self.t0, self.slot, self.piece, self.eta0, self.deta0, *self._arrays())
+                          self.t0, self.slot, self.piece, self.eta0, self.deta0, pk.reg, pk.dec, pk.wdh, pk.om,
+                          pk.omo, pk.Wc, pk.LW, pk.CW, pk.gen, pk.G, pk.Cd, pk.pw, pk.pre, pk.smask,
+                          *self.contactor_arrays, pk.dash, self.pieces[0], *self.pieces[2:])
         masks = self.packed.smask[self.slot[idx]] if self.n_segments else np.zeros(nt, dtype=np.int64)
         nc = len(self.contactors)
         engaged = ((masks[:, None] >> np.arange(nc)[None, :]) & 1).astype(bool)
@@ -366,18 +405,19 @@ class Solution(PiecewiseSolution):
         out[1] = np.nan
         if n and self.n_segments:
             Wr, row = self._row_table([q[0] for q in queries])
-            lo, hi, sign, offset, cond = (np.array(v) for v in zip(*(q[1:] for q in queries)))
+            lo, hi, sign, offset, cond = (np.array(v) for v in zip(*(q[1:6] for q in queries)))
             cond = np.array([-1 if c is None else c for c in cond], dtype=np.int64)
+            rate = np.array([q[6] if len(q) > 6 else 0.0 for q in queries], dtype=float)
             _dense.extremum(
                 lo.astype(float), np.minimum(hi.astype(float), self.t_end), sign.astype(float),
-                offset.astype(float), row, cond, self._atol, 1e-14, Wr, out[0], out[1],
-                self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, *self._arrays(),
+                offset.astype(float), rate, row, cond, self._atol, 1e-14, Wr, out[0], out[1],
+                self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, *self._model(),
             )
         return out.T
 
     def extremum(self, x: float, lo: float, hi: float, sign: float = 1.0, offset: float = 0.0,
-                 engaged: int | None = None) -> tuple[float, float]:
-        v, t = self.extrema([(x, lo, hi, sign, offset, engaged)])[0]
+                 engaged: int | None = None, rate: float = 0.0) -> tuple[float, float]:
+        v, t = self.extrema([(x, lo, hi, sign, offset, engaged, rate)])[0]
         return float(v), float(t)
 
     def integrals(self, queries: list[tuple[float, float, float]]) -> np.ndarray:
@@ -388,7 +428,7 @@ class Solution(PiecewiseSolution):
             lo = np.array([q[1] for q in queries], dtype=float)
             hi = np.minimum(np.array([q[2] for q in queries], dtype=float), self.t_end)
             _dense.integral(lo, hi, row, Wr, out, self.t0, self.t1, self.slot, self.piece, self.eta0,
-                            self.deta0, *self._arrays())
+                            self.deta0, *self._model())
         return out
 
     def integral(self, x: float, lo: float, hi: float) -> float:

@@ -16,6 +16,7 @@ from ..model.beam import Beam, Contactor
 from ..model.loading import Excitation, spatial_projection
 from ..modal import ModeSet, mode_set
 from ..model import Damping
+from .damping import dashpot_coefficient, state_damping_matrix
 
 __all__ = ["ModalDynamics", "StateModel", "StateSpace"]
 
@@ -53,6 +54,12 @@ class ModalDynamics:
         return np.sqrt(np.where(self.over, -self._disc, 0.0))
 
 
+def _preload_key(preload: Excitation | None) -> tuple:
+    if preload is None:
+        return ()
+    return (preload.kind, preload.position, float(preload.amplitude) * float(getattr(preload, "scale", 1.0)))
+
+
 # State models are pure functions of their inputs (all immutable), so they are
 # shared between simulations: a parameter study that varies only the load or
 # the gaps reuses modes, shapes at the points and projections.
@@ -76,6 +83,12 @@ class StateModel:
         Mode shapes at the output points.
     load_weights : ndarray, (n,)
         ``p_n`` with modal load ``p_n u(t)`` (paper eq. 8).
+    preload_weights : ndarray, (n,)
+        The preload's constant modal force (zero without a preload).
+    damping_matrix : ndarray, (n, n), or None
+        The damping in the state's modal frame when its modes do not
+        diagonalise it (:mod:`~impactbeam.solver.damping`); None when
+        ``dyn.decay`` says it all.
     """
 
     engaged: tuple[int, ...]
@@ -84,6 +97,8 @@ class StateModel:
     W_contact: np.ndarray
     W_out: np.ndarray
     load_weights: np.ndarray
+    preload_weights: np.ndarray
+    damping_matrix: np.ndarray | None = None
 
     @property
     def omega_max(self) -> float:
@@ -103,6 +118,9 @@ class ProblemSpace:
         Retained modes per state (the paper's N).
     points : ndarray, [m]
         Output positions.
+    preload : Excitation, optional
+        A constant load acting throughout (its ``kind``, ``position`` and
+        ``amplitude`` times ``scale``).
     """
 
     def __init__(
@@ -113,21 +131,61 @@ class ProblemSpace:
         excitation: Excitation,
         n_modes: int,
         points: np.ndarray,
+        preload: Excitation | None = None,
     ) -> None:
         self.beam = beam
         self.contactors = tuple(contactors)
         self.damping = damping
         self.excitation = excitation
+        self.preload = preload
         self.n_modes = n_modes
         self.points = np.asarray(points, dtype=float).reshape(-1)
         self.positions = np.array([c.position for c in self.contactors], dtype=float)
         self._states: dict[tuple[int, ...], StateModel] = {}
         self._proj: dict[tuple, np.ndarray] = {}  # projections / changes of coordinates between states
+        self._dashpots: np.ndarray | None = None
 
     @property
     def states(self) -> dict[tuple[int, ...], StateModel]:
         """The states built so far, by their engaged contactors."""
         return self._states
+
+    def undamped(self, engaged: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Frequencies and shapes at the contactors of a state, without its damping (subclasses)."""
+        raise NotImplementedError
+
+    @property
+    def dashpots(self) -> np.ndarray:
+        """Each contactor's dashpot [N s/m] (from ``damping`` or ``restitution``)."""
+        if self._dashpots is None:
+            out = np.zeros(len(self.contactors))
+            for i, c in enumerate(self.contactors):
+                if c.dissipative:
+                    omega, Wc = self.undamped((i,))
+                    out[i] = dashpot_coefficient(c, omega, Wc[i])
+            self._dashpots = out
+        return self._dashpots
+
+    def _dynamics(self, engaged: tuple[int, ...], omega: np.ndarray, Wc: np.ndarray, overlap_with_free
+                  ) -> tuple[ModalDynamics, np.ndarray | None]:
+        """Decay rates of the state's modes, or its damping matrix when they do not diagonalise it.
+
+        ``overlap_with_free()`` gives ``<W_n, W_m^free>`` (called for ``"free_modes"`` contact states only).
+        """
+        overlap = free_omega = None
+        if self.damping.model == "free_modes" and engaged:
+            overlap = overlap_with_free()
+            free_omega = self.state(()).modes.omega
+        C, diagonal = state_damping_matrix(self.damping, engaged, omega, Wc, self.dashpots, overlap, free_omega)
+        if diagonal:
+            return ModalDynamics(omega, 0.5 * np.diag(C).copy()), None
+        return ModalDynamics(omega, np.zeros_like(omega)), C
+
+    def _preload_weights(self, shapes_at, integral: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+        if self.preload is None:
+            return np.zeros_like(integral)
+        p = spatial_projection(self.preload, shapes_at, integral, self.beam.mass_per_length, inertia=inertia)
+        return p * float(self.preload.amplitude) * float(getattr(self.preload, "scale", 1.0))
 
 
 class StateSpace(ProblemSpace):
@@ -138,7 +196,7 @@ class StateSpace(ProblemSpace):
         if st is None:
             key = (
                 self.beam, self.contactors, engaged, self.damping, self.excitation.kind,
-                self.excitation.position, self.n_modes, tuple(self.points.tolist()),
+                self.excitation.position, self.n_modes, tuple(self.points.tolist()), _preload_key(self.preload),
             )
             st = _STATE_CACHE.get(key)
             if st is None:
@@ -149,17 +207,25 @@ class StateSpace(ProblemSpace):
             self._states[engaged] = st
         return st
 
-    def _build(self, engaged: tuple[int, ...]) -> StateModel:
+    def _modes(self, engaged: tuple[int, ...]) -> ModeSet:
         springs = [(self.contactors[i].position, self.contactors[i].stiffness) for i in engaged]
-        ms = mode_set(self.beam, springs, self.n_modes)
-        dyn = ModalDynamics(ms.omega, self.damping.decay_rates(bool(engaged), ms.omega))
+        return mode_set(self.beam, springs, self.n_modes)
+
+    def undamped(self, engaged: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+        ms = self._modes(engaged)
+        Wc = np.ascontiguousarray(ms.shapes(self.positions).T) if self.contactors else np.zeros((0, ms.count))
+        return ms.omega, Wc
+
+    def _build(self, engaged: tuple[int, ...]) -> StateModel:
+        ms = self._modes(engaged)
         n = ms.count
         Wc = np.ascontiguousarray(ms.shapes(self.positions).T) if self.contactors else np.zeros((0, n))
         Wo = np.ascontiguousarray(ms.shapes(self.points).T) if self.points.size else np.zeros((0, n))
-        p = spatial_projection(
-            self.excitation, ms.shapes, ms.integral(), self.beam.mass_per_length, inertia=ms.inertia_integral()
-        )
-        return StateModel(engaged, ms, dyn, Wc, Wo, p)
+        integral, inertia = ms.integral(), ms.inertia_integral()
+        p = spatial_projection(self.excitation, ms.shapes, integral, self.beam.mass_per_length, inertia=inertia)
+        pre = self._preload_weights(ms.shapes, integral, inertia)
+        dyn, C = self._dynamics(engaged, ms.omega, Wc, lambda: ms.overlap(self.state(()).modes))
+        return StateModel(engaged, ms, dyn, Wc, Wo, p, pre, C)
 
     def projection(self, to: tuple[int, ...], frm: tuple[int, ...]) -> np.ndarray:
         """``P[n, p] = rho A int W_n^to W_p^from dx`` (paper eq. 12)."""
