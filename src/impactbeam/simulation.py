@@ -48,6 +48,7 @@ def simulate_system(
     progress: Callable[[float], None] | None = None,
     name: str = "system",
     start: ModalState | None = None,
+    preload: Excitation | None = None,
 ) -> SimulationResult:
     """Simulate a beam given as objects rather than as a scenario; see :func:`simulate`.
 
@@ -73,6 +74,9 @@ def simulate_system(
         Name of the run (in result files).
     start : ModalState, optional
         As for :func:`simulate`.
+    preload : Excitation, optional
+        A constant load acting throughout (``kind``, ``position``,
+        ``amplitude``): gravity as a base acceleration, or a point force.
     """
     damping = damping or Damping()
     excitation = excitation or Excitation()
@@ -109,10 +113,10 @@ def simulate_system(
         if method == "ivp":
             from .solver.reference import integrate_ivp
 
-            solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt)
+            solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt, preload)
         else:
             solution = integrate(beam, contactors, damping, excitation, initial, opt, progress,
-                                 None if start is None else (start.eta, start.deta))
+                                 None if start is None else (start.eta, start.deta), preload)
         if announce:
             for text in solution.warnings:
                 warn(text)

@@ -172,9 +172,10 @@ def block_structure(omega: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.nd
     As[:n, n:] = np.diag(d)
     As[n:, :n] = -np.diag(omega**2 / d)
     As[n:, n:] = -C
-    # rigid-body modes the damping does not touch stay modes of their own
+    # rigid-body modes the damping does not touch stay modes of their own (a coupling below 1e-10 of
+    # the largest rate is the round-off of a rigid mode's shape at a dashpot, where it does not move)
     cmax = np.maximum(np.max(np.abs(C), axis=0), np.max(np.abs(C), axis=1))
-    untouched = (omega == 0.0) & (cmax <= 1e-14 * max(float(np.max(np.abs(C))), 1e-300))
+    untouched = (omega == 0.0) & (cmax <= 1e-10 * max(float(np.max(np.abs(C))), 1e-300))
     blocks: list[np.ndarray] = []
     for m in np.flatnonzero(untouched):
         Y = np.zeros((2 * n, 2))
@@ -248,9 +249,16 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
     dec = np.zeros(n)
     om = np.zeros(n)
     unscale = np.concatenate([1.0 / dscale, np.ones(n)])  # xs -> x
+    # round-off floors, as the states' own rigid-body threshold (eigenvalues below 1e-13 of the largest):
+    # a rigid-body block gets exact polynomials, not A / omega^2 against its homogeneous part
+    rate = max(float(np.max(omega)), float(np.max(np.abs(C))), 1e-300)
     for k, Y in enumerate(blocks):
         M = Y.T @ As @ Y
         S, a, w2 = _companion(M)
+        if w2 < 1e-13 * rate**2:
+            w2 = 0.0
+        if abs(a) < 1e-13 * rate:
+            a = 0.0
         GS = unscale[:, None] * (Y @ S)
         Gm[:, k] = GS[:, 0]
         Gm[:, n + k] = GS[:, 1]

@@ -261,6 +261,7 @@ class _Reference:
             float(np.sum(self.stiff * self.gap * np.max(np.abs(st.W_contact), axis=1))) / w_ref**2
             if self.contactors
             else 0.0,
+            float(np.max(np.abs(st.preload_weights), initial=0.0)) / w_ref**2,
             1e-300,
         )
         a = RTOL * 1e-3 * U

@@ -1,0 +1,308 @@
+"""Energy loss as FE users write it: contactor dashpots, restitution, free-mode and Rayleigh damping, preload.
+
+The exact engine integrates a state whose modes do not diagonalise its
+damping through the exact blocks of its first-order system
+(:mod:`impactbeam.solver.blocks`); the ``solve_ivp`` path
+(:mod:`impactbeam.solver.reference`) integrates the same modal equations with
+the full damping matrix and its own event functions. They share only the
+modal data and the damping matrices of the states, so their agreement checks
+the blocks, the generalised closed form, the dashpot's force-release events
+and the released phase. Tolerances are those of ``tests/test_engine.py``
+(event times 1e-9 s, metrics 1e-7 relative, peak forces and impulses 1e-6:
+DOP853 at rtol 1e-10 locates events to ~1e-12 s, amplified by the impacts).
+
+Independent truths besides: the single spring-dashpot impact (its coefficient
+of restitution against a DOP853 integration and published values), the
+energy balance (the dashpots take exactly what the beam loses), linearity of
+the ratios Rayleigh damping gives, and the static equilibrium a preload holds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import impactbeam as ib
+from impactbeam.exceptions import ParameterError
+from impactbeam.model import Damping
+from impactbeam.model.beam import Contactor, Support
+from impactbeam.model.loading import Excitation
+from impactbeam.solver.damping import restitution_of, restitution_ratio
+
+from test_engine import EXAMPLES, compare, problem, run, with_contactor, with_options
+
+
+# --------------------------------------------------------------------------- one spring-dashpot impact
+
+def _sdof_restitution(xi: float) -> float:
+    """A unit mass meets F = k d + c d' (k = 1, never pulling) at unit speed: rebound speed (DOP853)."""
+    def rhs(t, y):
+        return [y[1], -(y[0] + 2.0 * xi * y[1])]
+
+    def released(t, y):  # the force k d + c d' reaches 0
+        return y[0] + 2.0 * xi * y[1]
+
+    released.terminal = True
+    released.direction = -1.0
+    sol = solve_ivp(rhs, (0.0, 100.0), [0.0, 1.0], events=released, rtol=1e-12, atol=1e-14, method="DOP853")
+    t_hit = [t for t in sol.t_events[0] if t > 1e-9]
+    assert t_hit
+    return -float(sol.sol(t_hit[0])[1]) if sol.sol is not None else -float(sol.y_events[0][-1][1])
+
+
+@pytest.mark.parametrize("xi", [0.01, 0.1, 0.3, 0.7071, 0.9, 1.0, 1.5, 4.0])
+def test_restitution_of_a_spring_dashpot_impact(xi):
+    # closed form of the release (d'' = 0) against DOP853 with an event on the force
+    # (rtol 1e-12: the rebound speed to ~1e-11; 1e-9 leaves room, a wrong formula is off by 1e-2)
+    assert restitution_of(xi) == pytest.approx(_sdof_restitution(xi), rel=1e-9)
+
+
+def test_restitution_published_values_and_inverse():
+    # Schwager & Poeschel, Phys. Rev. E 78 (2008) 051304: with the force-based release
+    # the restitution is exp(-beta / omega (pi - arctan(2 beta omega / (omega^2 - beta^2)))),
+    # beta = xi, omega = sqrt(1 - xi^2) (their eq. 16, under-damped); at xi = 0.1 that is 0.7458
+    xi = 0.1
+    w = math.sqrt(1 - xi**2)
+    published = math.exp(-xi / w * (math.pi - math.atan(2 * xi * w / (w**2 - xi**2))))
+    assert restitution_of(xi) == pytest.approx(published, rel=1e-12)
+    assert restitution_of(0.0) == 1.0 and restitution_ratio(1.0) == 0.0
+    for e in (0.05, 0.3, 0.6, 0.95, 0.999):
+        assert restitution_of(restitution_ratio(e)) == pytest.approx(e, rel=1e-12)
+
+
+def test_restitution_of_a_nearly_rigid_beam():
+    # A very stiff free-free beam dropped flat onto a soft stop at its middle is a rigid
+    # mass on a spring-dashpot: the rebound speed over the approach speed is e. The
+    # elastic modes (first at 100 x the bounce frequency) take a share of order
+    # (omega_bounce / omega_1)^2 = 1e-4 of the motion: tolerance 2e-3.
+    sc = ib.load_scenario(EXAMPLES / "specimen.toml")
+    beam = dataclasses.replace(sc.beam, youngs_modulus=sc.beam.youngs_modulus * 1e6,
+                               left=Support.preset("free"), right=Support.preset("free"))
+    L, m = beam.length, beam.mass_per_length * beam.length
+    k = 50.0
+    e = 0.6
+    stop = Contactor(0.5 * L, k, 1e-4, "below", restitution=e)
+    v0 = -0.05  # toward the stop
+    initial = ib.InitialCondition(modal_velocity=(v0 * math.sqrt(m),))  # the translation mode, 1/sqrt(m)
+    opts = ib.SolverOptions(modes=4, time_step=1e-4, end_time=0.2)
+    res = ib.simulate_system(beam, (stop,), initial=initial, options=opts, points=[0.5 * L])
+    ev = res.events
+    assert [x.kind for x in ev[:2]] == ["impact", "rebound"]
+    assert -ev[1].velocity / ev[0].velocity == pytest.approx(e, rel=2e-3)
+    assert res.solution.dashpots[0] == pytest.approx(2 * restitution_ratio(e) * math.sqrt(k * m), rel=2e-3)
+
+
+# --------------------------------------------------------------------------- exact engine against solve_ivp
+
+def _dash(c=0.5, **kw):
+    return with_contactor(problem(), 0, damping=c, **kw)
+
+
+DISSIPATIVE = {
+    "dashpot_soft": lambda: _dash(0.5),
+    "dashpot_zero_gap": lambda: _dash(0.5, gap=0.0),
+    "dashpot_stiff_stop": lambda: _dash(2.0, stiffness=1e5),
+    "dashpot_overdamped_contact_mode": lambda: _dash(40.0),
+    "restitution_0.3": lambda: with_contactor(problem(), 0, restitution=0.3),
+    "dashpot_paper_basis": lambda: with_options(_dash(0.5), basis="paper"),
+    "dashpot_many_modes": lambda: with_options(_dash(1.0, stiffness=1e5), modes=24),
+    "free_modes": lambda: problem(damping=Damping(0.02, model="free_modes")),
+    # the paper's projection (eq. 12) with a stop 2.5 times Case 3's (at 1e5 N/m it is lossy enough that
+    # the two methods part ways after 7 events, with modal damping as well: the warning says so)
+    "free_modes_paper": lambda: with_options(with_contactor(problem(damping=Damping(0.02, model="free_modes")),
+                                                            0, stiffness=1e4), basis="paper"),
+    "free_modes_and_dashpot": lambda: with_contactor(problem(damping=Damping(0.011, model="free_modes")), 0,
+                                                     damping=0.3),
+    "rayleigh": lambda: problem(damping=Damping(model="rayleigh", alpha=8.0, beta=2e-6)),
+    "rayleigh_and_dashpot": lambda: with_contactor(problem(damping=Damping(model="rayleigh", alpha=3.0, beta=1e-6)),
+                                                   0, damping=0.4),
+}
+
+
+@pytest.mark.parametrize("name", list(DISSIPATIVE))
+def test_dissipative_models_agree_with_solve_ivp(name):
+    args = DISSIPATIVE[name]()
+    ex, _ = compare(args)
+    assert ex.events
+    if args["options"].basis != "paper":  # eq. (12) loses energy at a switch by design
+        # the energy balance at the switches: the changes of mechanical energy are exactly what the
+        # dashpots take there (round-off: ~1e-13 of the energy per switch, a few dozen switches)
+        scale = float(np.max(ex.energy["total"]))
+        assert abs(ex.metrics()["energy_residual"]) <= 1e-10 * scale
+
+
+@pytest.mark.parametrize("seed, kind", [(0, "light"), (1, "heavy"), (2, "near_critical"), (3, "rigid_untouched"),
+                                         (4, "rigid_damped")])
+def test_blocks_reproduce_the_matrix_exponential(seed, kind):
+    # The block coordinates of a state (solver/blocks.py) advanced by the compiled closed form
+    # against scipy's expm of the augmented first-order system, under a constant and a linear
+    # load: every regime, rigid modes the damping does or does not touch, a near-critical pair.
+    # Both are exact; the difference is round-off amplified by the blocks' conditioning (1e-11).
+    from scipy.linalg import expm
+
+    from impactbeam.solver import _closed
+    from impactbeam.solver.blocks import slot_arrays
+
+    rng = np.random.default_rng(seed)
+    n = 7
+    om = np.sort(rng.uniform(50.0, 3000.0, n))
+    R = rng.normal(size=(n, 3))
+    C = {"light": 20.0, "heavy": 3000.0, "near_critical": 1.0, "rigid_untouched": 50.0, "rigid_damped": 50.0}[kind] \
+        * (R @ R.T) / n + np.diag(rng.uniform(0.1, 2.0, n))
+    if kind == "near_critical":  # one mode at critical damping with a weak coupling: a nearly defective pair
+        C = 1e-3 * C + np.diag(2.0 * om * (np.arange(n) == 2))
+    if kind.startswith("rigid"):
+        om[0] = 0.0
+        if kind == "rigid_untouched":
+            C[0, :] = C[:, 0] = 0.0
+    pw = rng.normal(size=n)
+    sa = slot_arrays(om, C, np.zeros((0, n)), pw, np.zeros(n))
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -np.diag(om**2)
+    A[n:, n:] = -C
+    b = np.concatenate([np.zeros(n), pw])
+    x0 = rng.normal(size=2 * n) * np.concatenate([1.0 / np.maximum(om, 50.0), np.ones(n)])
+    u0, u1, T = 0.7, -300.0, 3e-3
+    aug = np.zeros((2 * n + 2, 2 * n + 2))  # x' = A x + b (u0 + u1 t): states (x, u0 + u1 t, u1)
+    aug[: 2 * n, : 2 * n] = A
+    aug[: 2 * n, 2 * n] = b
+    aug[2 * n, 2 * n + 1] = 1.0
+    xT = (expm(aug * T) @ np.concatenate([x0, [u0, u1]]))[: 2 * n]
+    Hm = np.concatenate([sa.H[0], sa.H[1]])
+    Gm = np.concatenate([sa.G[0], sa.G[1]], axis=1)
+    bu, au = sa.LW[0], sa.LW[1]
+    zz = Hm @ x0
+    z, dz = zz[:n], zz[n:] + au * u0
+    h0, dh0, P, lA, lB, lD, lE, AL = _closed.workspace(n)
+    y = bu + 2.0 * sa.dec * au
+    lA[:], lB[:], lD[:], lE[:] = y * u0 + au * u1, y * u1, 0.0, 0.0
+    _closed.setup(sa.reg, sa.dec, sa.om, lA, lB, lD, lE, 0.0, 0.0, z, dz, h0, dh0, P)
+    e, d = np.empty(n), np.empty(n)
+    _closed.state_at(T, sa.reg, sa.dec, sa.wdh, sa.om, h0, dh0, P, 0.0, 0.0, e, d)
+    xb = Gm @ np.concatenate([e, d - au * (u0 + u1 * T)])
+    scale = np.concatenate([np.full(n, np.abs(xT[:n]).max()), np.full(n, np.abs(xT[n:]).max())])
+    assert np.abs(xb - xT).max() / 1.0 <= 1e-11 * scale.max()
+    assert np.all(np.abs(xb - xT) <= 1e-10 * scale)
+
+
+def test_two_dashpot_contactors_on_a_free_free_beam():
+    # rigid-body modes (one untouched by the dashpots in some states), stops on both sides
+    sc = ib.load_scenario(EXAMPLES / "case03.toml")
+    beam = dataclasses.replace(sc.beam, left=Support.preset("free"), right=Support.preset("free"))
+    L = beam.length
+    cs = (Contactor(0.15 * L, 4030.0, 2e-4, "below", damping=0.8), Contactor(0.85 * L, 2e4, 1e-4, "above",
+                                                                            damping=0.2),
+          Contactor(0.5 * L, 4030.0, 5e-4, "above"))
+    exc = Excitation(kind="point_force", shape="half_sine", amplitude=-0.05, duration=0.004, position=0.3 * L)
+    ex, _ = compare(problem(beam=beam, contactors=cs, excitation=exc, points=[0.0, L],
+                            damping=Damping(0.01, 0.01)))
+    assert ex.solution.packed.general and len(ex.events) >= 4
+
+
+def test_harmonic_load_with_a_dashpot():
+    exc = Excitation(kind="base_acceleration", shape="harmonic", amplitude=30.0, frequency=60.0)
+    args = with_options(_dash(0.3), end_time=0.1)
+    compare({**args, "excitation": exc})
+
+
+def test_a_dashpot_releases_before_the_penetration_returns():
+    # the force k d + c d' reaches zero while d > 0: the contact ends there (never pulls),
+    # so the penetration at every rebound is -(c/k) d' > 0 and the force never negative
+    args = _dash(2.0)
+    res = run(with_options(args, time_step=1e-6, end_time=0.06))
+    rebounds = [(e, d) for e, d in zip(res.events, res.solution.event_penetrations) if e.kind == "rebound"]
+    assert rebounds
+    c, k = res.solution.dashpots[0], args["contactors"][0].stiffness
+    for ev, d in rebounds:
+        s = args["contactors"][0].direction
+        assert d > 0 and d == pytest.approx(-(c / k) * s * ev.velocity, rel=1e-6)
+    f = res.contact_force[:, 0]
+    assert f.min() >= 0.0
+    # the force is continuous at the release: near zero just before each rebound time
+    for ev, _ in rebounds:
+        i = int(np.searchsorted(res.time, ev.time)) - 1
+        assert f[i] <= 1e-3 * f.max()
+
+
+def test_dashpots_report_what_they_dissipate():
+    # the ledger: kinetic + strain + contactor energy + beam damping + dashpots = input work,
+    # sampled at 2e-6 s (trapezoid rule: ~3e-4 of the input work, the sampling's own error)
+    res = run(with_options(_dash(0.5), time_step=2e-6))
+    en = res.energy
+    assert en["dashpots"][-1] > 0.05 * en["input_work"][-1]
+    assert np.abs(en["residual"]).max() <= 5e-4 * en["input_work"][-1]
+    undamped = run(with_options(problem(damping=Damping(0.011, 0.02)), time_step=2e-6))
+    assert np.all(undamped.energy["dashpots"] == 0.0)
+
+
+def test_rayleigh_ratios_are_alpha_over_2_omega_plus_beta_omega_over_2():
+    sc = ib.load_scenario(EXAMPLES / "case03.toml")
+    d = Damping(model="rayleigh", alpha=6.0, beta=3e-6)
+    sp = ib.solver.engine.make_space(sc.beam, sc.contactors, d, sc.excitation, sc.solver, np.zeros(0))
+    for key in ((), (0,)):
+        st = sp.state(key)
+        om = st.modes.omega
+        assert st.damping_matrix is None
+        np.testing.assert_allclose(st.dyn.decay / om, 6.0 / (2 * om) + 3e-6 * om / 2, rtol=1e-14)
+
+
+def test_free_mode_damping_keeps_the_free_operator_in_every_state():
+    # in the shared basis the contact state's matrix is Phi_c^T D Phi_c with D the free
+    # state's diag(2 xi omega): its eigen-decomposition gives the free modes' rates back
+    sc = ib.load_scenario(EXAMPLES / "case03.toml")
+    d = Damping(0.02, model="free_modes")
+    sp = ib.solver.engine.make_space(sc.beam, sc.contactors, d, sc.excitation, sc.solver, np.zeros(0))
+    free, contact = sp.state(()), sp.state((0,))
+    Phi = contact.modes.Phi.T @ free.modes.Phi
+    back = Phi.T @ contact.damping_matrix @ Phi
+    np.testing.assert_allclose(back, np.diag(2 * 0.02 * free.modes.omega), atol=1e-10 * free.modes.omega.max())
+
+
+# --------------------------------------------------------------------------- preload
+
+def test_a_preload_alone_keeps_its_static_equilibrium():
+    # a constant tip force from t = 0 on a cantilever at its static deflection: no motion;
+    # start from rest instead: it oscillates about that deflection (mean = static) and the
+    # exact engine and solve_ivp agree
+    args = problem(excitation=Excitation(), contactors=(), points=[0.1092])
+    pre = Excitation(kind="point_force", shape="step", amplitude=-0.02, position=0.1092)
+    res = ib.simulate_system(args["beam"], (), excitation=Excitation(), options=args["options"], points=[0.1092],
+                             preload=pre, damping=Damping(0.5, 0.5))
+    ivp = ib.simulate_system(args["beam"], (), excitation=Excitation(), options=args["options"], points=[0.1092],
+                             preload=pre, damping=Damping(0.5, 0.5), method="ivp")
+    b = args["beam"]
+    static = -0.02 * b.length**3 / (3 * b.bending_stiffness)
+    late = res.displacement([0.1092], [0.19, 0.2])[0]
+    assert late == pytest.approx([static, static], rel=2e-3)  # 8 modes' static flexibility, and decay to 1e-5
+    np.testing.assert_allclose(res.displacement([0.1092], [0.05, 0.1]), ivp.displacement([0.1092], [0.05, 0.1]),
+                               rtol=1e-7)
+
+
+# --------------------------------------------------------------------------- bad input
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: Contactor(0.05, 4030.0, damping=-1.0), "contactor.damping"),
+    (lambda: Contactor(0.05, 4030.0, restitution=0.0), "contactor.restitution"),
+    (lambda: Contactor(0.05, 4030.0, restitution=1.2), "contactor.restitution"),
+    (lambda: Contactor(0.05, 4030.0, damping=1.0, restitution=0.5), "not both"),
+    (lambda: Damping(0.02, model="rayleigh"), "damping.free"),
+    (lambda: Damping(alpha=1.0), "damping.alpha"),
+    (lambda: Damping(0.01, 0.02, model="free_modes"), "damping.contact"),
+    (lambda: Damping(model="viscous"), "damping.model"),
+    (lambda: Damping(model="rayleigh", beta=-1e-6), "damping.beta"),
+])
+def test_bad_dissipation_input_names_the_key(make, match):
+    with pytest.raises(ParameterError, match=match):
+        make()
+
+
+def test_shooting_refuses_non_proportional_states():
+    sc = ib.load_scenario(EXAMPLES / "periodic" / "specimen_harmonic.toml")
+    sc = sc.with_values({"contactors.0.damping": 0.5})
+    with pytest.raises(ParameterError, match="dashpots"):
+        ib.periodic_orbit(sc)
