@@ -15,6 +15,7 @@ from typing import Any
 
 from impactbeam.scenario import schema as S
 from impactbeam.model.beam import SUPPORT_PRESETS
+from impactbeam.model.damping import DAMPING_MODELS
 
 #: Meaning and unit of every leaf key, by dotted path ([] marks the array of tables).
 MEANING: dict[str, str] = {
@@ -38,8 +39,13 @@ MEANING: dict[str, str] = {
     "contactors[].stiffness": "Contact spring stiffness k [N/m], acting only while engaged.",
     "contactors[].gap": "Clearance c [m] between the beam at rest and the contactor surface.",
     "contactors[].side": "Where the contactor is: `below` pushes while w(a) < -gap, `above` while w(a) > gap.",
-    "damping.free": "Modal damping ratio xi_n of the free state (paper eq. 9): one value or one per mode.",
-    "damping.contact": "Modal damping ratio of states with a contactor engaged: one value or one per mode.",
+    "contactors[].damping": "Dashpot c [N s/m] in parallel with the spring: force k d + c d' while positive (never pulls).",
+    "contactors[].restitution": "Coefficient of restitution 0 < e <= 1 instead of `damping` (see the dissipation page).",
+    "damping.model": "`modal` (per-state ratios, the paper), `free_modes` (the free state's ratios kept in every state) or `rayleigh`.",
+    "damping.free": "Modal damping ratio xi_n of the free state (paper eq. 9): one value or one per mode (`modal`, `free_modes`).",
+    "damping.contact": "Modal damping ratio of states with a contactor engaged: one value or one per mode (`modal`).",
+    "damping.alpha": "Rayleigh mass coefficient alpha [1/s]: C = alpha M + beta K (`rayleigh`).",
+    "damping.beta": "Rayleigh stiffness coefficient beta [s] (`rayleigh`).",
     "excitation.kind": "What the load is.",
     "excitation.shape": "Time history: half-sine pulse, step, harmonic, or a table from `file`.",
     "excitation.amplitude": "Peak value: [m/s^2] (or g) for base acceleration, [N] point force, [N/m] distributed.",
@@ -100,6 +106,7 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "excitation.shape": S._SHAPES,
     "excitation.hold": S._HOLDS,
     "contactors[].side": S._SIDES,
+    "damping.model": DAMPING_MODELS,
     "output.fields": S.OUTPUT_FIELDS,
     "supports.left": tuple(SUPPORT_PRESETS),
     "supports.right": tuple(SUPPORT_PRESETS),
