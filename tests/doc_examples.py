@@ -102,7 +102,7 @@ def items(page: Path) -> list[Item]:
             pending.append(Directive(d.group(1), _parse_args(d.group(2)), d.group(2), i + 1))
             i += 1
             continue
-        if not line.strip():
+        if not line.strip() or re.fullmatch(r"<!--.*-->", line.strip()):  # other comments are transparent
             i += 1
             continue
         f = _FENCE.match(line)
@@ -190,7 +190,8 @@ def value_agrees(shown: str, value: float) -> bool:
     a, u = float(shown), _ulp(shown)
     if u == 0.0 and float(value).is_integer():
         return a == value
-    return abs(a - value) <= 0.5 * max(u, 0.0) * (1 + 1e-9) + ROUNDOFF * abs(value)
+    u = u or 1.0  # a value rounded to a whole number
+    return abs(a - value) <= 0.5 * u * (1 + 1e-9) + ROUNDOFF * abs(value)
 
 
 def _pattern(shown: str) -> tuple[str, list[str]]:

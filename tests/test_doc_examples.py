@@ -145,12 +145,25 @@ def _run_console(it: dx.Item, cwd: Path, env: dict[str, str], ignore: re.Pattern
 
 def _run_python(it: dx.Item, globs: dict[str, Any]) -> list[str]:
     text = "\n".join(it.lines)
+    if ">>>" not in text:  # a script that shows no output: it must run
+        import contextlib
+        import io
+        import traceback
+
+        try:
+            with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
+                warnings.simplefilter("default")
+                exec(compile(text, it.where, "exec"), globs)
+        except Exception:  # noqa: BLE001 - reported as the example's failure
+            return [f"{it.where}: the example fails:\n{traceback.format_exc(limit=3)}"]
+        return []
     test = doctest.DocTestParser().get_doctest(text, globs, it.where, str(it.page), it.line)
     report: list[str] = []
     runner = doctest.DocTestRunner(checker=_NumberChecker(), optionflags=doctest.ELLIPSIS)
     with warnings.catch_warnings():
         warnings.simplefilter("default")  # warnings go to stderr, as for a reader running the example
         runner.run(test, out=report.append, clear_globs=False)
+    globs.update(test.globs)  # the page's later blocks continue in this namespace
     return [f"{it.where}:\n{r}" for r in report]
 
 
@@ -338,6 +351,9 @@ def _sampled_hold():
             row[f"{hold} hold [m]"] = float(np.abs(r.w - exact).max())
         rows[str(n)] = row
     return rows, {}
+
+
+TEXTS["ritz"] = lambda: repr(TABLES["ritz"]()[0])
 
 
 # ------------------------------------------------------------------ the paper's reproduction
