@@ -124,6 +124,9 @@ def _shell_env(tmp: Path) -> dict[str, str]:
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), *filter(None, [env.get("PYTHONPATH")])])
     env["PYTHONUNBUFFERED"] = "1"  # stdout and stderr in the order a terminal shows them
     env["MPLBACKEND"] = "Agg"
+    # Dask's notice that another cluster on this machine holds its dashboard port: a fact about the
+    # machine, not about the example
+    env["PYTHONWARNINGS"] = "ignore:Port:UserWarning"
     return env
 
 

@@ -5,8 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pathlib import Path
+
 import impactbeam as ib
 from impactbeam import paper, plot
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 @pytest.fixture(scope="module")
@@ -183,3 +187,49 @@ def test_result_in_a_notebook_is_a_compact_summary():
     assert "max response" in html and "1.0172 mm" in html and "contactor 0" in html
     assert list(res.impacts.columns) == ["contactor", "start", "end", "duration", "peak_force", "impulse"]
     assert len(res.impacts) == 12
+
+
+# --------------------------------------------------------------------------- the metrics figure
+
+
+def test_plot_metrics_marks_each_metric_at_its_value(tmp_path):
+    # The figure of docs/metrics.md: every mark sits where the metric says (exact values, in mm and ms),
+    # the durations span the intervals of the events, and the force panel marks the impact table.
+    res = ib.simulate(ib.load_scenario(EXAMPLES / "case03.toml"))
+    m = res.metrics()
+    h = plot.plot_metrics(res, tmp_path / "m.png")
+    a = h.artists
+    assert a["max_response"].get_xdata()[0] == pytest.approx(m["t_max"] * 1e3)
+    assert a["max_response"].get_ydata()[0] == pytest.approx(m["max_response"] * 1e3)
+    assert a["t_max"].get_xdata()[0] == pytest.approx(m["t_max"] * 1e3)
+    assert a["first_impact_time"].get_xdata()[0] == pytest.approx(m["first_impact_time"] * 1e3)
+    assert a["min_response"].get_ydata()[0] == pytest.approx(m["min_response"] * 1e3)
+    assert a["surface"].get_ydata()[0] == pytest.approx(-0.229)  # u = -gap
+    (f0, _), (f1, _) = a["free_duration"].xyann, a["free_duration"].xy
+    assert f1 - f0 == pytest.approx(m["free_duration"] * 1e3)
+    (c0, _), (c1, _) = a["contact_duration"].xyann, a["contact_duration"].xy
+    assert c1 - c0 == pytest.approx(m["contact_duration"] * 1e3) and c0 == pytest.approx(m["first_impact_time"] * 1e3)
+    (_, top), (_, deep) = a["max_penetration"].xyann, a["max_penetration"].xy
+    assert top - deep == pytest.approx(m["max_penetration"] * 1e3)
+    row = m["impacts"][0]
+    assert a["peak_force"].get_ydata()[0] == pytest.approx(row["peak_force"])
+    assert a["start"].get_xdata()[0] == pytest.approx(row["start"] * 1e3)
+    assert a["end"].get_xdata()[0] == pytest.approx(row["end"] * 1e3)
+    # the shaded impulse integrates (trapezoid on the 10 us grid) to the exact impulse within 1e-3:
+    # the force is smooth inside a contact and vanishes at its ends
+    verts = a["impulse"].get_paths()[0].vertices
+    inside = (res.time >= row["start"]) & (res.time <= row["end"])
+    f, t = res.contact_force[inside, 0], res.time[inside]
+    area = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(t)))
+    assert area == pytest.approx(row["impulse"], rel=1e-3) and verts[:, 1].max() <= row["peak_force"] * (1 + 1e-9)
+    assert h.figure.get_figwidth() == pytest.approx(7.0)
+    assert str(m["n_impacts"]) in a["n_impacts"].get_text()
+    assert (tmp_path / "m.png").stat().st_size > 0
+
+
+def test_plot_metrics_needs_a_contact_after_the_peak(case12):
+    with pytest.raises(ib.ParameterError, match="no contactor"):
+        plot.plot_metrics(case12)
+    sc = ib.load_scenario(EXAMPLES / "case03.toml").with_values({"solver.end_time": 0.015})  # stops before any impact
+    with pytest.raises(ib.ParameterError, match="contact_duration is null"):
+        plot.plot_metrics(ib.simulate(sc))
