@@ -19,7 +19,7 @@ from typing import Any
 import click
 
 from .._io import PLOT_SUFFIXES, check_output, json_text
-from ._group import handle_errors, load_with_overrides, progress_bar, take_warnings, warning_lines
+from ._group import handle_errors, load_with_overrides, progress_bar, take_warnings
 from ..exceptions import ParameterError
 
 __all__ = ["bifurcation_command", "bifurcation_map_command"]
@@ -143,11 +143,10 @@ def bifurcation_command(scenario: str, parameter: str, values: str | None, span:
         except OSError as exc:
             click.echo(f'error: {option}: cannot write "{path}": {exc.strerror or exc}', err=True)
             sys.exit(1)
-    caught = take_warnings()
     if as_json:
-        click.echo(json_text({**diagram.to_dict(), "warnings": caught}))
-    else:
-        click.echo("\n".join([_summary(diagram), *warning_lines(caught)]))
+        click.echo(json_text({**diagram.to_dict(), "warnings": take_warnings()}))
+    else:  # the table alone on stdout; the warnings go to stderr (handle_errors, when the command ends)
+        click.echo(_summary(diagram))
     for label, path in (("dataset", out), ("figure", plot), ("frequency-response figure", frf)):
         if path is not None:
             click.echo(f"wrote {label} to {path}", err=True)
@@ -206,9 +205,8 @@ def bifurcation_map_command(scenario: str, x_key: str, x_values: str | None, x_s
             click.echo(f'error: --plot: cannot write "{plot}": {exc.strerror or exc}', err=True)
             sys.exit(1)
     none = int(((ds["period"].values == 0) & ds["done"].values[:, None]).sum())
-    lines = [f"map of {y_key} x {x_key}: {ds.sizes['y']} x {ds.sizes['x']} steady states in {out}"]
+    click.echo(f"map of {y_key} x {x_key}: {ds.sizes['y']} x {ds.sizes['x']} steady states in {out}")
     if none:
-        lines.append(f"warning: {none} of them without a period within the record (period = 0 in the store)")
-    click.echo("\n".join([*lines, *warning_lines(take_warnings())]))
+        click.echo(f"warning: {none} of them without a period within the record (period = 0 in the store)", err=True)
     if plot is not None:
         click.echo(f"wrote figure to {plot}", err=True)

@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from .._io import PLOT_SUFFIXES, RESULT_SUFFIXES, check_output, json_text
-from ._group import fail, handle_errors, progress_bar, load_with_overrides, take_warnings, warning_lines
+from ._group import fail, handle_errors, load_with_overrides, progress_bar, take_warnings
 
 __all__ = ["simulate"]
 
@@ -109,11 +109,10 @@ def simulate(
             fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:
             fail(f'--plot: cannot write "{plot}": {exc}', 1)
-    caught = take_warnings()
     if as_json:
-        click.echo(json_text({**metrics, "warnings": caught}))
-    else:
-        click.echo("\n".join([_summary(sc, metrics), *warning_lines(caught)]))
+        click.echo(json_text({**metrics, "warnings": take_warnings()}))
+    else:  # the warnings go to stderr, printed by handle_errors when the command ends
+        click.echo(_summary(sc, metrics))
     for label, path in (("result", out), ("figure", plot)):
         if path is not None:
             click.echo(f"wrote {label} to {path}", err=True)
