@@ -22,7 +22,7 @@ from .._io import PLOT_SUFFIXES, check_output, json_text
 from ._group import handle_errors, load_with_overrides, progress_bar, take_warnings
 from ..exceptions import ParameterError
 
-__all__ = ["bifurcation_command", "bifurcation_map_command"]
+__all__ = ["bifurcation_command", "bifurcation_map_command", "frf_figure"]
 
 
 def _values(parameter: str, values: str | None, span: tuple[str, str, str] | None, sc: Any,
@@ -74,6 +74,17 @@ def _summary(diagram: Any) -> str:
         lines.append(f"{p.value:12.6g} {p.direction:>5} {per:>6} {s.impacts_per_period:14.4g} "
                      f"{s.max * 1e3:10.4g} {s.min * 1e3:10.4g}")
     return "\n".join(lines)
+
+
+def frf_figure(scenario: Any, diagram: Any, path: str | None = None) -> Any:
+    """The frequency-response figure of ``--frf``: the diagram's extremes with the first contactor's surface.
+
+    The strobe point is the first contactor, so its surface is drawn on its
+    side: ``w = -gap`` for a contactor below the beam, ``+gap`` above.
+    """
+    from ..periodic.frf import from_diagram
+
+    return from_diagram(scenario, diagram).plot(path, contactor=scenario.contactors[0] if scenario.contactors else None)
 
 
 @click.command("bifurcation")
@@ -128,14 +139,8 @@ def bifurcation_command(scenario: str, parameter: str, values: str | None, span:
     with _progress() as report:
         diagram = bifurcation(sc, parameter, vals, sweep=sweep, from_rest=from_rest,  # type: ignore[arg-type]
                               settle_periods=settle, record_periods=record, progress=report)
-    def write_frf(path: str) -> None:
-        from ..periodic.frf import from_diagram
-
-        gap = sc.contactors[0].gap if sc.contactors else None
-        from_diagram(sc, diagram).plot(path, gap=gap)
-
     for option, path, write in (("--out", out, diagram.write), ("--plot", plot, diagram.plot),
-                                ("--frf", frf, write_frf)):
+                                ("--frf", frf, lambda p: frf_figure(sc, diagram, p))):
         if path is None:
             continue
         try:
