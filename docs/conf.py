@@ -2,15 +2,19 @@
 
 Sphinx rather than MkDocs: the docstrings are numpydoc (rendered by the
 numpydoc extension), the command-line reference is generated from the click
-objects by sphinx-click, and myst-nb executes the tutorial notebooks during
-the build, so every output shown is the output of the current code. The
-scenario reference is generated from the schema in ``impactbeam.scenario``
-by ``_ext/scenario_reference.py``. Warnings fail the build (``-W``).
+objects by sphinx-click, MathJax is served from the site itself
+(sphinx-mathjax-offline: no network is needed to read the equations), and
+myst-nb executes the tutorial notebooks during the build, so every output
+shown is the output of the current code. The scenario reference is
+generated from the schema in ``impactbeam.scenario`` by
+``_ext/scenario_reference.py``, the metrics figure from the solver by
+``_ext/metrics_figure.py``. Warnings fail the build (``-W``).
 """
 
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -33,11 +37,13 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax copied into _static/mathjax: no CDN, equations render offline
     "sphinx.ext.intersphinx",
     "numpydoc",
     "myst_nb",
     "sphinx_click",
     "scenario_reference",
+    "metrics_figure",
 ]
 
 source_suffix = {".md": "myst-nb", ".ipynb": "myst-nb", ".rst": "restructuredtext"}
@@ -69,10 +75,25 @@ html_static_path: list[str] = []
 html_theme_options = {"description": "Transient response of impacting beams", "fixed_sidebar": True}
 
 
+_ADDRESS = re.compile(r"\b([a-z][a-z0-9+.-]*://[^\s),]+)")
+_OPTION = re.compile(r"(?<![\w`-])(--[a-z][\w-]*)")
+
+
 def _plain_help(app, ctx, lines):  # noqa: ANN001 - sphinx-click event signature
-    """Click help is plain text: escape the characters reStructuredText would interpret."""
+    """Click help is plain text: escape the characters reStructuredText would interpret.
+
+    Addresses such as ``tcp://127.0.0.1:8786`` are examples to type, not
+    pages to visit: they are set as literals, which docutils does not link;
+    so are options (``--json``), which smart quotes would turn into a dash.
+    """
     for i, line in enumerate(lines):
-        lines[i] = line.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*").replace("`", "\\`")
+        if line.lstrip().startswith(".. "):  # sphinx-click's own directives (``.. option:: --modes <N|auto>``)
+            continue
+        block = re.match(r"\s*\| ", line)  # a line block: sphinx-click's rendering of click's \b paragraphs
+        head, body = (line[: block.end()], line[block.end():]) if block else ("", line)
+        body = body.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*").replace("`", "\\`")
+        body = _OPTION.sub(r"``\1``", _ADDRESS.sub(r"``\1``", body))
+        lines[i] = head + body
 
 
 def setup(app):  # noqa: ANN001, ANN201

@@ -13,7 +13,6 @@ from pathlib import Path
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import impactbeam as ib  # noqa: E402
@@ -31,13 +30,10 @@ def main() -> None:
     d = ib.bifurcation(sc, "excitation.frequency", f, sweep="both")
     d.plot(FIG / "periodic_frequency.png")
     fr = ib.frequency_response(sc, f, sweep="both")
-    fr.plot(FIG / "periodic_frf.png", gap=sc.contactors[0].gap)
+    fr.plot(FIG / "periodic_frf.png", contactor=sc.contactors[0])
     a = ib.bifurcation(sc.with_values({"excitation.frequency": 55.0}), "excitation.amplitude",
                        np.linspace(4.5 * G, 6.5 * G, 201), sweep="both")
-    fig = a.plot(scale=1e3)
-    fig.axes[1].set_xlabel("excitation.amplitude [m/s^2]")
-    fig.savefig(FIG / "periodic_amplitude.png", dpi=130)
-    plt.close(fig)
+    a.plot(FIG / "periodic_amplitude.png", x_scale=1 / G, xlabel="base acceleration amplitude [g]")
     ds = ib.bifurcation_map(sc, ("excitation.frequency", np.linspace(30.0, 90.0, 121)),
                             ("excitation.amplitude", np.linspace(0.5 * G, 4.0 * G, 36)),
                             ROOT / "out" / "periodic_map.zarr", settle_periods=100, record_periods=20)

@@ -10,6 +10,7 @@ errors) is the ``docs`` marked test.
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import time
@@ -117,3 +118,33 @@ def test_docs_build_without_warnings(tmp_path: Path) -> None:
         assert f'id="impactbeam-{command}"' in cli, command
     assert "image/png" not in (html / "tutorials/first-simulation.html").read_text()  # images are files
     assert list((html / "_images").glob("*.png"))
+    # equations render offline: MathJax is served from the site, no page loads a script or style from the network
+    assert (html / "_static" / "mathjax" / "tex-chtml.js").is_file()
+    assert "_static/mathjax/tex-chtml.js" in (html / "model.html").read_text()
+    remote = []
+    for page in html.rglob("*.html"):
+        text = page.read_text(encoding="utf-8")
+        remote += [f"{page.name}: {u}" for u in re.findall(r'<(?:script|link|img)\b[^>]*?(?:src|href)="((?:https?:)?//[^"]+)"', text)]
+    assert not remote, remote
+    # addresses in command help are literals, not links (tcp://... is not a page)
+    assert 'href="tcp://' not in cli and "<span class=\"pre\">tcp://127.0.0.1:8786</span>" in cli
+    assert (html / "_images" / "metrics-case03.png").is_file()  # the metrics page's figure, drawn at build time
+
+
+def test_metrics_figure_is_drawn_from_the_code(tmp_path: Path) -> None:
+    # docs/_ext/metrics_figure.py draws the figure of the metrics page at every build (here without Sphinx)
+    pytest.importorskip("matplotlib")
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        import metrics_figure
+    finally:
+        sys.path.pop(0)
+    handles = metrics_figure.draw(tmp_path / "m.png")
+    assert (tmp_path / "m.png").stat().st_size > 10_000
+    assert "Case 3" in handles.axes[0].get_title()
+
+
+def test_every_docs_page_is_in_a_table_of_contents() -> None:
+    index = (DOCS / "index.md").read_text()
+    pages = {p.stem for p in DOCS.glob("*.md")} - {"index"}
+    assert not [p for p in pages if f"\n{p}\n" not in index], "add the page to a toctree of docs/index.md"

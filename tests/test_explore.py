@@ -200,3 +200,35 @@ def test_explorer_in_headless_chromium(tmp_path: Path) -> None:
             server.wait(timeout=20)
         except subprocess.TimeoutExpired:
             server.kill()
+
+
+def test_page_shows_the_surface_and_shades_the_contacts() -> None:
+    # issue 19: the response plot shows the stop's surface (u = -gap) and the contact intervals,
+    # both following the sliders; the force is a solid line
+    pytest.importorskip("panel", reason="the explore extra (panel) is not installed")
+    from impactbeam.explore import ExplorerPage
+    from impactbeam.result.metrics import contact_intervals
+
+    sc = ib.load_scenario(CASE3)
+    page = ExplorerPage(sc)
+    assert page.surface.visible and page.surface.location == pytest.approx(-0.229)
+    spans = page.contacts.data
+    ref = contact_intervals(ib.simulate(sc), 0)
+    assert len(spans["left"]) == len(ref) == 12
+    assert spans["left"] == pytest.approx([a * 1e3 for a, _ in ref]) and spans["right"] == pytest.approx(
+        [b * 1e3 for _, b in ref])
+    assert all(b == page.u_range.start for b in spans["bottom"]) and all(t == page.u_range.end for t in spans["top"])
+    assert page.u_range.start < -0.229 < page.u_range.end
+    assert page.force_line.glyph.line_dash == []  # solid
+    assert page.set_value("gap", 0.300)
+    assert page.surface.location == pytest.approx(-0.300)
+    ref = contact_intervals(ib.simulate(sc.with_values({"contactors.0.gap": 0.300e-3})), 0)
+    assert page.contacts.data["left"] == pytest.approx([a * 1e3 for a, _ in ref])
+
+
+def test_page_without_contactor_has_no_surface() -> None:
+    pytest.importorskip("panel", reason="the explore extra (panel) is not installed")
+    from impactbeam.explore import ExplorerPage
+
+    page = ExplorerPage(ib.load_scenario(ROOT / "examples" / "case12.toml"))
+    assert not page.surface.visible and page.contacts.data["left"] == []

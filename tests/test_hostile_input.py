@@ -74,7 +74,7 @@ def test_compare_against_a_constant_record(tmp_path: Path, level: float) -> None
     proc = run("compare", EXAMPLES / "case03.toml", p)
     assert proc.returncode == 0, proc.stderr
     assert "inf" not in proc.stdout and "nan" not in proc.stdout.lower()
-    assert any(line.startswith("warning: ") and "constant" in line for line in proc.stdout.splitlines())
+    assert any(line.startswith("warning: ") and "constant" in line for line in proc.stderr.splitlines())
     d = json.loads(run("compare", EXAMPLES / "case03.toml", p, "--json").stdout)
     assert any("constant" in w for w in d["warnings"])
     if level == 0.0:

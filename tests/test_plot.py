@@ -5,8 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pathlib import Path
+
 import impactbeam as ib
 from impactbeam import paper, plot
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 @pytest.fixture(scope="module")
@@ -183,3 +187,148 @@ def test_result_in_a_notebook_is_a_compact_summary():
     assert "max response" in html and "1.0172 mm" in html and "contactor 0" in html
     assert list(res.impacts.columns) == ["contactor", "start", "end", "duration", "peak_force", "impulse"]
     assert len(res.impacts) == 12
+
+
+# --------------------------------------------------------------------------- the metrics figure
+
+
+def test_plot_metrics_marks_each_metric_at_its_value(tmp_path):
+    # The figure of docs/metrics.md: every mark sits where the metric says (exact values, in mm and ms),
+    # the durations span the intervals of the events, and the force panel marks the impact table.
+    res = ib.simulate(ib.load_scenario(EXAMPLES / "case03.toml"))
+    m = res.metrics()
+    h = plot.plot_metrics(res, tmp_path / "m.png")
+    a = h.artists
+    assert a["max_response"].get_xdata()[0] == pytest.approx(m["t_max"] * 1e3)
+    assert a["max_response"].get_ydata()[0] == pytest.approx(m["max_response"] * 1e3)
+    assert a["t_max"].get_xdata()[0] == pytest.approx(m["t_max"] * 1e3)
+    assert a["first_impact_time"].get_xdata()[0] == pytest.approx(m["first_impact_time"] * 1e3)
+    assert a["min_response"].get_ydata()[0] == pytest.approx(m["min_response"] * 1e3)
+    assert a["surface"].get_ydata()[0] == pytest.approx(-0.229)  # u = -gap
+    (f0, _), (f1, _) = a["free_duration"].xyann, a["free_duration"].xy
+    assert f1 - f0 == pytest.approx(m["free_duration"] * 1e3)
+    (c0, _), (c1, _) = a["contact_duration"].xyann, a["contact_duration"].xy
+    assert c1 - c0 == pytest.approx(m["contact_duration"] * 1e3) and c0 == pytest.approx(m["first_impact_time"] * 1e3)
+    (_, top), (_, deep) = a["max_penetration"].xyann, a["max_penetration"].xy
+    assert top - deep == pytest.approx(m["max_penetration"] * 1e3)
+    row = m["impacts"][0]
+    assert a["peak_force"].get_ydata()[0] == pytest.approx(row["peak_force"])
+    assert a["start"].get_xdata()[0] == pytest.approx(row["start"] * 1e3)
+    assert a["end"].get_xdata()[0] == pytest.approx(row["end"] * 1e3)
+    # the shaded impulse integrates (trapezoid on the 10 us grid) to the exact impulse within 1e-3:
+    # the force is smooth inside a contact and vanishes at its ends
+    verts = a["impulse"].get_paths()[0].vertices
+    inside = (res.time >= row["start"]) & (res.time <= row["end"])
+    f, t = res.contact_force[inside, 0], res.time[inside]
+    area = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(t)))
+    assert area == pytest.approx(row["impulse"], rel=1e-3) and verts[:, 1].max() <= row["peak_force"] * (1 + 1e-9)
+    assert h.figure.get_figwidth() == pytest.approx(7.0)
+    assert str(m["n_impacts"]) in a["n_impacts"].get_text()
+    assert (tmp_path / "m.png").stat().st_size > 0
+
+
+def test_plot_metrics_needs_a_contact_after_the_peak(case12):
+    with pytest.raises(ib.ParameterError, match="no contactor"):
+        plot.plot_metrics(case12)
+    sc = ib.load_scenario(EXAMPLES / "case03.toml").with_values({"solver.end_time": 0.015})  # stops before any impact
+    with pytest.raises(ib.ParameterError, match="contact_duration is null"):
+        plot.plot_metrics(ib.simulate(sc))
+
+
+# --------------------------------------------------------------------------- periodic motion
+
+
+def _no_pyplot_figures() -> int:
+    import matplotlib.pyplot as plt
+
+    return len(plt.get_fignums())
+
+
+@pytest.fixture(scope="module", params=["below", "above"])
+def harmonic_diagram(request):
+    # the specimen against its 0.1 mm stop on either side, three forcing frequencies around the
+    # impacting resonance (short settling: the figure, not the orbit, is under test)
+    import warnings
+
+    sc = ib.load_scenario(EXAMPLES / "periodic" / "specimen_harmonic.toml").with_values(
+        {"contactors.0.side": request.param})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ib.ImpactBeamWarning)  # short settling: periods may not be found
+        d = ib.bifurcation(sc, "excitation.frequency", [55.0, 60.0, 72.0], sweep="both", settle_periods=30,
+                           record_periods=4)
+    return sc, d
+
+
+def test_frequency_response_draws_the_surface_on_the_contactors_side(harmonic_diagram):
+    # The caller's bug of issue 19: a stop below has its surface at w = -gap, not +gap. Through the
+    # command's own figure function (impactbeam bifurcation --frf).
+    import warnings
+
+    from impactbeam.cli.cmd_bifurcation import frf_figure
+
+    sc, d = harmonic_diagram
+    c = sc.contactors[0]
+    before = _no_pyplot_figures()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ib.ImpactBeamWarning)  # short settling: periods may not be found
+        h = frf_figure(sc, d)
+    y = h.artists["surface"].get_ydata()[0]
+    assert y == pytest.approx((-0.1 if c.side == "below" else 0.1))  # mm
+    assert np.sign(y) == (-1.0 if c.side == "below" else 1.0)
+    assert "-gap" in h.artists["surface"].get_label() if c.side == "below" else "+gap" in h.artists["surface"].get_label()
+    assert _no_pyplot_figures() == before  # a bare figure, pyplot untouched
+    assert h.figure.get_figwidth() == pytest.approx(7.0)
+
+
+def test_frequency_response_axis_holds_the_impacting_branch_not_the_linear_peak():
+    # Evidence for the scale: the linear FRF of the specimen peaks at ~3.5 mm near 57 Hz while the
+    # impacting branch stays within ~1.7 mm; the axis is set by the simulated extremes (and the surface).
+    from types import SimpleNamespace
+
+    f = np.linspace(50.0, 64.0, 15)
+    lin = 1e-3 / (np.abs(f - 57.0) + 0.3)  # a sharp linear peak, 3.3 mm
+    fr = SimpleNamespace(frequency=np.concatenate([f, f[::-1]]), direction=np.array(["up"] * 15 + ["down"] * 15),
+                         max=np.full(30, 0.4e-3), min=np.full(30, -0.6e-3), linear=np.concatenate([lin, lin[::-1]]),
+                         point=0.0529)
+    h = plot.plot_frequency_response(fr)
+    lo, hi = h.axes[0].get_ylim()
+    assert -0.8 < lo < -0.6 and 0.4 < hi < 0.6  # mm: the extremes with a margin
+    assert "off scale" in h.artists["linear_peak"].get_text() and "3.33" in h.artists["linear_peak"].get_text()
+    assert h.artists["surface"] is None
+
+
+def test_bifurcation_figure_is_journal_styled_with_the_impact_markers_in_the_legend():
+    from types import SimpleNamespace
+
+    def point(value, direction, period, ipp):
+        state = SimpleNamespace(strobe=np.array([1e-4, 2e-4]), period=period, impacts_per_period=ipp)
+        return SimpleNamespace(value=value, direction=direction, state=state)
+
+    d = SimpleNamespace(parameter="excitation.frequency", unit="Hz",
+                        points=[point(50.0, "up", 1, 1.0), point(51.0, "up", 0, 1.5),
+                                point(51.0, "down", 2, 2.0), point(50.0, "down", 1, 1.0)])
+    before = _no_pyplot_figures()
+    h = plot.plot_bifurcation(d)
+    assert _no_pyplot_figures() == before
+    labels = [t.get_text() for t in h.artists["legend"].get_texts()]
+    assert "impacts per response period, up" in labels and "impacts per response period, down" in labels
+    assert "no period found: impacts per forcing period, up" in labels
+    assert h.figure.get_figwidth() == pytest.approx(7.0)
+    assert h.axes[1].get_xlabel() == "forcing frequency [Hz]"
+    sizes = {t.get_fontsize() for a in h.axes for t in (a.xaxis.label, a.yaxis.label, *a.get_yticklabels())}
+    assert min(sizes) >= 8  # journal fonts at print size
+
+
+def test_paper_case3_detail_shows_u_and_every_contact():
+    # issue 19: the report's detail figure plots u = -w and must say so; its axis ran to 80 ms, before
+    # the last of Case 3's 12 contacts
+    from impactbeam.paper.figures import case3_detail
+    from impactbeam.result.metrics import contact_intervals
+
+    res = ib.simulate(paper.case(3))
+    h = case3_detail(res)
+    ax = h.axes[0]
+    assert "u = -w" in " ".join(a.get_title() for a in h.axes) and ax.get_ylabel().endswith("u [mm]")
+    np.testing.assert_allclose(h.lines[0].get_ydata(), -res.w_contact[:, 0] * 1e3)  # u = -w (contactor above)
+    last_end = contact_intervals(res, 0)[-1][1]
+    assert len(contact_intervals(res, 0)) == 12 and ax.get_xlim()[1] >= last_end * 1e3

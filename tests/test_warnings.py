@@ -64,12 +64,14 @@ def test_api_warns_at_the_users_line(tmp_path: Path, text: str, needle: str) -> 
 
 
 @pytest.mark.parametrize(("text", "needle"), WARNED)
-def test_cli_reports_warnings_in_summary_and_json(tmp_path: Path, text: str, needle: str) -> None:
+def test_cli_reports_warnings_on_stderr_and_in_json(tmp_path: Path, text: str, needle: str) -> None:
+    # beside the summary on the terminal, but on stderr: stdout stays the summary alone (issue 19)
     p = tmp_path / "w.toml"
     p.write_text(text)
     proc = run("simulate", p)
     assert proc.returncode == 0, proc.stderr
-    assert any(line.startswith("warning: ") and needle in line for line in proc.stdout.splitlines()), proc.stdout
+    assert any(line.startswith("warning: ") and needle in line for line in proc.stderr.splitlines()), proc.stderr
+    assert "warning:" not in proc.stdout
     proc = run("simulate", p, "--json")
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)

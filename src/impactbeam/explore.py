@@ -1,27 +1,26 @@
 """The live explorer: sliders for a scenario's main parameters, redrawn on change.
 
 ``impactbeam explore [SCENARIO] [--port N]`` serves a page on 127.0.0.1 with
-sliders for the gap, contact stiffness and position of the first contactor,
-the pulse amplitude and duration, the modal damping of the free and contact
-states (paper eq. 9) and the number of modes per state. Every change
-re-simulates the scenario with :func:`impactbeam.simulate` and redraws the
-response ``u`` at the first contactor (the quantity of the metrics), the
-contact force, and the metrics table, with the time the update took. A
-button downloads the current scenario as TOML.
+sliders for the first contactor's gap, stiffness and position, the pulse
+amplitude and duration, the modal damping of both states (paper eq. 9) and
+the modes per state. Every change re-simulates (:func:`impactbeam.simulate`)
+and redraws the response ``u`` at the first contactor (the metrics'
+quantity) with the contactor's surface and the contact intervals shaded,
+the contact force and the metrics table; a button downloads the scenario as
+TOML. The figures, sliders and table are Bokeh models updated in place
+(:class:`ExplorerPage`): one websocket message per change, the curves
+decimated to about one point per pixel column with the extrema kept. A
+slider step of Case 3 is redrawn 40-60 ms after the key press on 2 cores
+(``benchmarks/bench_explore.py``).
 
-Panel serves the page on the Bokeh server; the figures, sliders and table
-are Bokeh models updated in place (:class:`ExplorerPage`), so a change sends
-one websocket message with the new curves (decimated to about one point per
-pixel column, extrema kept), the axis ranges and the table. For the
-reference Case 3, a slider step is redrawn in the browser about 40-60 ms
-after the key press on a 2-core machine, of which the simulation and the
-sampling of the plotted curve take about 15 ms (``benchmarks/bench_explore.py``
-measures it).
+The browser draws the page from the server's websocket: a page saved, or a
+screenshot taken by a headless browser, without that live connection shows
+empty panels. For a static figure of a run use ``impactbeam simulate
+SCENARIO --plot FILE`` or :func:`impactbeam.plot.plot_result`.
 
-The model part (:class:`ExplorerModel`) has no web dependency and is what
-the tests check against :func:`impactbeam.simulate`; Panel is needed only
-by :class:`ExplorerPage`, :func:`build_app` and :func:`serve` (the
-``explore`` extra).
+:class:`ExplorerModel` has no web dependency (the tests check it against
+:func:`impactbeam.simulate`); Panel is needed by :class:`ExplorerPage`,
+:func:`build_app` and :func:`serve` only (the ``explore`` extra).
 """
 
 from __future__ import annotations
@@ -39,10 +38,11 @@ import numpy as np
 
 from ._optional import require
 from .exceptions import ParameterError
-from .result.metrics import METRIC_DISPLAY
+from .result.metrics import METRIC_DISPLAY, contact_intervals
 from .scenario import Scenario, parse_scenario
 
-__all__ = ["SLIDERS", "ExplorerModel", "ExplorerPage", "Slider", "build_app", "curves", "envelope", "envelope_index", "serve"]
+__all__ = ["SLIDERS", "ExplorerModel", "ExplorerPage", "Slider", "build_app", "contact_spans", "curves", "envelope",
+           "envelope_index", "serve"]
 
 G = 9.80665  # standard gravity [m/s^2], for base accelerations shown in g
 
@@ -186,7 +186,9 @@ class ExplorerModel:
             ``time_ms``; ``u_mm``, the metric deflection ``u`` [mm] at the first
             contactor (``-w`` above, ``w`` below) or ``w`` at the first output
             point; ``force_N``, the first contactor's force (zeros without
-            one); ``metrics`` (:meth:`SimulationResult.metrics`); ``seconds``,
+            one); ``contacts_ms``, its contact intervals (start, end) [ms];
+            ``surface_mm``, its surface ``u = -gap`` [mm] (None without one);
+            ``metrics`` (:meth:`SimulationResult.metrics`); ``seconds``,
             the wall time of the simulation and its metrics; ``sample_seconds``,
             that of sampling ``u`` and the force on the output grid.
 
@@ -204,8 +206,10 @@ class ExplorerModel:
         metrics = res.metrics()
         t1 = time.perf_counter()
         t = np.asarray(res.time)
+        contacts: list[tuple[float, float]] = []
         if sc.contactors:
             c = sc.contactors[0]
+            contacts = [(a * 1e3, min(b, float(t[-1])) * 1e3) for a, b in contact_intervals(res, 0)]
             samples = res.solution.sample(np.array([c.position]), t)
             u = -c.direction * samples.w[:, 0]  # -w above, w below: the opening is gap + u
             engaged = samples.engaged[:, 0]
@@ -215,8 +219,9 @@ class ExplorerModel:
             u = np.asarray(res.displacement([sc.output_points[0]], t)).reshape(-1)
             force = np.zeros_like(t)
         t2 = time.perf_counter()
-        return {"time_ms": t * 1e3, "u_mm": u * 1e3, "force_N": force, "metrics": metrics,
-                "seconds": t1 - t0, "sample_seconds": t2 - t1}
+        surface = -sc.contactors[0].gap * 1e3 if sc.contactors else None
+        return {"time_ms": t * 1e3, "u_mm": u * 1e3, "force_N": force, "metrics": metrics, "contacts_ms": contacts,
+                "surface_mm": surface, "seconds": t1 - t0, "sample_seconds": t2 - t1}
 
     def toml(self) -> str:
         """The current scenario as TOML text (loads back to the same scenario)."""
@@ -265,10 +270,8 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int = 1000) -> tuple[np.ndarray
 
     Parameters
     ----------
-    t : ndarray
-        Times.
-    y : ndarray
-        Values at ``t``.
+    t, y : ndarray
+        Times and the values at them.
     bins : int
         Buckets; each keeps its minimum and maximum.
     """
@@ -306,6 +309,25 @@ def padded_range(y: np.ndarray, pad: float = 0.05) -> tuple[float, float]:
     lo, hi = float(finite.min()), float(finite.max())
     span = hi - lo if hi > lo else max(abs(hi), 1.0)
     return lo - pad * span, hi + pad * span
+
+
+def _surface(out: dict[str, Any]) -> list[float]:
+    return [] if out["surface_mm"] is None else [out["surface_mm"]]
+
+
+def contact_spans(out: dict[str, Any], bottom: float, top: float) -> dict[str, list[float]]:
+    """The shaded contact intervals of a :meth:`ExplorerModel.run` output: columns of Bokeh quads [ms, mm].
+
+    Parameters
+    ----------
+    out : dict
+        From :meth:`ExplorerModel.run`.
+    bottom, top : float, [mm]
+        The height of the shading (the response axis' limits).
+    """
+    spans = out["contacts_ms"]
+    return {"left": [a for a, _ in spans], "right": [b for _, b in spans],
+            "bottom": [bottom] * len(spans), "top": [top] * len(spans)}
 
 
 def _fmt(value: Any, scale: float, unit: str) -> str:
@@ -352,6 +374,12 @@ class ExplorerPage:
     source : bokeh.models.ColumnDataSource
         The plotted columns ``t``, ``u``, ``f`` (:func:`curves`), replaced on
         every change.
+    contacts : bokeh.models.ColumnDataSource
+        The shaded contact intervals (:func:`contact_spans`).
+    surface : bokeh.models.Span
+        The first contactor's surface, ``u = -gap`` (hidden without one).
+    force_line : bokeh.models.GlyphRenderer
+        The contact force, a solid line.
     sliders : dict of str to bokeh.models.Slider
         The controls by :attr:`Slider.name`.
     table : bokeh.models.Div
@@ -386,14 +414,23 @@ class ExplorerPage:
         self.source = models.ColumnDataSource(c)
         t_end = float(out["time_ms"][-1])
         self.x_range = models.Range1d(0.0, t_end, reset_start=0.0, reset_end=t_end)
-        self.u_range = models.Range1d(*padded_range(c["u"]))
+        u_lo, u_hi = padded_range(np.append(c["u"], _surface(out)))  # the curve and the surface
+        self.u_range = models.Range1d(u_lo, u_hi)
         self.f_range = models.Range1d(*padded_range(c["f"]))
+        self.contacts = models.ColumnDataSource(contact_spans(out, u_lo, u_hi))
         kw = {"height": 260, "sizing_mode": "stretch_width", "tools": "pan,wheel_zoom,box_zoom,reset,save",
               "x_range": self.x_range, "x_axis_label": "time [ms]", "min_border_left": 70}
-        f_u = plotting.figure(title="Response u at the first contactor", y_axis_label="u [mm]", y_range=self.u_range, **kw)
+        title = "Response u at the first contactor" + (
+            " (shaded: in contact; dashed: its surface, u = -gap)" if out["surface_mm"] is not None else "")
+        f_u = plotting.figure(title=title, y_axis_label="u [mm]", y_range=self.u_range, **kw)
+        f_u.quad(left="left", right="right", bottom="bottom", top="top", source=self.contacts, fill_color="#000000",
+                 fill_alpha=0.12, line_alpha=0.0)
+        self.surface = models.Span(location=out["surface_mm"] or 0.0, dimension="width", line_color="#555555",
+                                   line_dash="dashed", line_width=1, visible=out["surface_mm"] is not None)
+        f_u.add_layout(self.surface)
         f_u.line("t", "u", source=self.source, line_width=1.5, color="#0072B2")
         f_f = plotting.figure(title="Contact force", y_axis_label="force [N]", y_range=self.f_range, **kw)
-        f_f.line("t", "f", source=self.source, line_width=1.5, color="#D55E00", line_dash="dashed")
+        self.force_line = f_f.line("t", "f", source=self.source, line_width=1.5, color="#D55E00")
         self.table = models.Div(text=metrics_html(self.model, out, None), css_classes=["ib-metrics"],
                                 sizing_mode="stretch_width")
         self.status = models.Div(text="", css_classes=["ib-status"], width=300)
@@ -463,10 +500,13 @@ class ExplorerPage:
             self.sliders[name].value = int(old) if s.integer else old * scale  # back to the value in force
             return False
         c = curves(out)
-        u_lo, u_hi = padded_range(c["u"])
+        u_lo, u_hi = padded_range(np.append(c["u"], _surface(out)))
         f_lo, f_hi = padded_range(c["f"])
         with unlocked():  # one message for the whole change
             self.source.data = c
+            self.contacts.data = contact_spans(out, u_lo, u_hi)
+            if out["surface_mm"] is not None:
+                self.surface.location = out["surface_mm"]
             self.u_range.update(start=u_lo, end=u_hi, reset_start=u_lo, reset_end=u_hi)
             self.f_range.update(start=f_lo, end=f_hi, reset_start=f_lo, reset_end=f_hi)
             self.table.text = metrics_html(self.model, out, (time.perf_counter() - t0) * 1e3)

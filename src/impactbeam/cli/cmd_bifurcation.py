@@ -19,10 +19,10 @@ from typing import Any
 import click
 
 from .._io import PLOT_SUFFIXES, check_output, json_text
-from ._group import handle_errors, load_with_overrides, progress_bar, take_warnings, warning_lines
+from ._group import handle_errors, load_with_overrides, progress_bar, take_warnings
 from ..exceptions import ParameterError
 
-__all__ = ["bifurcation_command", "bifurcation_map_command"]
+__all__ = ["bifurcation_command", "bifurcation_map_command", "frf_figure"]
 
 
 def _values(parameter: str, values: str | None, span: tuple[str, str, str] | None, sc: Any,
@@ -74,6 +74,17 @@ def _summary(diagram: Any) -> str:
         lines.append(f"{p.value:12.6g} {p.direction:>5} {per:>6} {s.impacts_per_period:14.4g} "
                      f"{s.max * 1e3:10.4g} {s.min * 1e3:10.4g}")
     return "\n".join(lines)
+
+
+def frf_figure(scenario: Any, diagram: Any, path: str | None = None) -> Any:
+    """The frequency-response figure of ``--frf``: the diagram's extremes with the first contactor's surface.
+
+    The strobe point is the first contactor, so its surface is drawn on its
+    side: ``w = -gap`` for a contactor below the beam, ``+gap`` above.
+    """
+    from ..periodic.frf import from_diagram
+
+    return from_diagram(scenario, diagram).plot(path, contactor=scenario.contactors[0] if scenario.contactors else None)
 
 
 @click.command("bifurcation")
@@ -128,14 +139,8 @@ def bifurcation_command(scenario: str, parameter: str, values: str | None, span:
     with _progress() as report:
         diagram = bifurcation(sc, parameter, vals, sweep=sweep, from_rest=from_rest,  # type: ignore[arg-type]
                               settle_periods=settle, record_periods=record, progress=report)
-    def write_frf(path: str) -> None:
-        from ..periodic.frf import from_diagram
-
-        gap = sc.contactors[0].gap if sc.contactors else None
-        from_diagram(sc, diagram).plot(path, gap=gap)
-
     for option, path, write in (("--out", out, diagram.write), ("--plot", plot, diagram.plot),
-                                ("--frf", frf, write_frf)):
+                                ("--frf", frf, lambda p: frf_figure(sc, diagram, p))):
         if path is None:
             continue
         try:
@@ -143,11 +148,10 @@ def bifurcation_command(scenario: str, parameter: str, values: str | None, span:
         except OSError as exc:
             click.echo(f'error: {option}: cannot write "{path}": {exc.strerror or exc}', err=True)
             sys.exit(1)
-    caught = take_warnings()
     if as_json:
-        click.echo(json_text({**diagram.to_dict(), "warnings": caught}))
-    else:
-        click.echo("\n".join([_summary(diagram), *warning_lines(caught)]))
+        click.echo(json_text({**diagram.to_dict(), "warnings": take_warnings()}))
+    else:  # the table alone on stdout; the warnings go to stderr (handle_errors, when the command ends)
+        click.echo(_summary(diagram))
     for label, path in (("dataset", out), ("figure", plot), ("frequency-response figure", frf)):
         if path is not None:
             click.echo(f"wrote {label} to {path}", err=True)
@@ -206,9 +210,8 @@ def bifurcation_map_command(scenario: str, x_key: str, x_values: str | None, x_s
             click.echo(f'error: --plot: cannot write "{plot}": {exc.strerror or exc}', err=True)
             sys.exit(1)
     none = int(((ds["period"].values == 0) & ds["done"].values[:, None]).sum())
-    lines = [f"map of {y_key} x {x_key}: {ds.sizes['y']} x {ds.sizes['x']} steady states in {out}"]
+    click.echo(f"map of {y_key} x {x_key}: {ds.sizes['y']} x {ds.sizes['x']} steady states in {out}")
     if none:
-        lines.append(f"warning: {none} of them without a period within the record (period = 0 in the store)")
-    click.echo("\n".join([*lines, *warning_lines(take_warnings())]))
+        click.echo(f"warning: {none} of them without a period within the record (period = 0 in the store)", err=True)
     if plot is not None:
         click.echo(f"wrote figure to {plot}", err=True)

@@ -15,7 +15,7 @@ from typing import Any
 import click
 
 from .._io import PLOT_SUFFIXES, check_output, json_text
-from ._group import handle_errors, number_or_text, take_warnings, warning_lines
+from ._group import handle_errors, number_or_text, take_warnings
 from ..exceptions import ParameterError
 
 __all__ = ["compare", "fit", "identify"]
@@ -170,11 +170,10 @@ def identify(
                 data = set_path(data, path, value)
             dump_scenario(data, out)
             result["out"] = out
-    result["warnings"] = take_warnings()
     if as_json:
-        click.echo(json_text(result))
-    else:
-        click.echo("\n".join([_identify_text(result), *warning_lines(result["warnings"])]))
+        click.echo(json_text({**result, "warnings": take_warnings()}))
+    else:  # the warnings go to stderr, printed by handle_errors when the command ends
+        click.echo(_identify_text(result))
     if out is not None:
         click.echo(f"wrote scenario to {out}", err=True)
 
@@ -268,14 +267,13 @@ def compare(
     cmp = run_compare(sc, meas, excitation=trace, hold=hold, point=x, window=win)  # type: ignore[arg-type]
     if plot is not None:
         cmp.plot(plot)
-    caught = take_warnings()
     if as_json:
         d = cmp.to_dict()
         d.update({"scenario": scenario, "measured": measured, "excitation": excitation,
-                  "hold": hold if excitation else None, "plot": plot, "warnings": caught})
+                  "hold": hold if excitation else None, "plot": plot, "warnings": take_warnings()})
         click.echo(json_text(d))
-    else:
-        click.echo("\n".join([cmp.table(), *warning_lines(caught)]))
+    else:  # the warnings go to stderr, printed by handle_errors when the command ends
+        click.echo(cmp.table())
     if plot is not None:
         click.echo(f"wrote figure to {plot}", err=True)
 
@@ -335,13 +333,12 @@ def fit(
     written: list[Path] = []
     if out is not None:
         written = res.write_scenario(out)
-    caught = take_warnings()
     if as_json:
         d = res.to_dict()
         d.update({"scenario": scenario, "measured": measured, "out": out,
-                  "written": [str(p) for p in written], "warnings": caught})
+                  "written": [str(p) for p in written], "warnings": take_warnings()})
         click.echo(json_text(d))
-    else:
-        click.echo("\n".join([res.report(), *warning_lines(caught)]))
+    else:  # the warnings go to stderr, printed by handle_errors when the command ends
+        click.echo(res.report())
     for p in written:
         click.echo(f"wrote {p}", err=True)

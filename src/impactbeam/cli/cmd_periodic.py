@@ -36,14 +36,13 @@ def periodic(scenario: str, multiple: int, settle_periods: float | None, max_ite
     "converged": false and a warning.
     """
     from .._io import json_text
-    from ._group import load_with_overrides, take_warnings, warning_lines
+    from ._group import load_with_overrides, take_warnings
     from ..periodic.shooting import periodic_orbit
 
     sc = load_with_overrides(scenario)
     orbit = periodic_orbit(sc, multiple=multiple, settle_periods=settle_periods, max_iterations=max_iterations)
-    caught = take_warnings()
     if as_json:
-        click.echo(json_text({**orbit.to_dict(), "warnings": caught}))
+        click.echo(json_text({**orbit.to_dict(), "warnings": take_warnings()}))
         return
     lines = [f"Periodic orbit of {sc.name!r}: period {orbit.multiple} x 1/f = {orbit.period * 1e3:.6g} ms",
              f"  {orbit.message}",
@@ -53,4 +52,4 @@ def periodic(scenario: str, multiple: int, settle_periods: float | None, max_ite
     lines.append("  largest multipliers |mu|: " + ", ".join(f"{abs(m):.6g}" for m in shown)
                  + (" ..." if orbit.multipliers.size > shown.size else ""))
     lines.append(f"  {'stable' if orbit.stable else 'NOT stable' if orbit.converged else 'not converged'}")
-    click.echo("\n".join([*lines, *warning_lines(caught)]))
+    click.echo("\n".join(lines))  # the warnings go to stderr, printed by handle_errors when the command ends

@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from .._io import PLOT_SUFFIXES, RESULT_SUFFIXES, check_output, json_text
-from ._group import fail, handle_errors, progress_bar, load_with_overrides, take_warnings, warning_lines
+from ._group import fail, handle_errors, load_with_overrides, progress_bar, take_warnings
 
 __all__ = ["simulate"]
 
@@ -40,9 +40,25 @@ def simulate(
 ) -> None:
     """Simulate SCENARIO and print the response metrics.
 
-    The metrics are those of w at the first contactor (or the first output
-    point without contactors), as u positive away from the contactor
-    (u = -w for a contactor above the beam, u = w below).
+    The metrics are read on u, the deflection w at the first contactor (the
+    first output point without contactors) positive away from it: u = -w
+    for a contactor above the beam, u = w below; contact is u < -gap. In
+    the summary lengths are in mm and times in ms; --json gives SI values,
+    null where a metric does not apply.
+
+    \b
+    max_response       the largest u; t_max its time
+    first_impact_time  the start of the first contact
+    n_impacts          the contacts that begin during the run
+    free_duration      the free interval containing t_max: from the last
+                       rebound before it (or t = 0) to the next impact
+    contact_duration   the first contact that begins after t_max
+    min_response       the least u in that contact
+    max_penetration    the deepest compression of the run, max(-gap - u)
+
+    --json adds "impacts", one row per contact of every contactor:
+    contactor, start, end, duration, peak_force (the largest contact force)
+    and impulse (the integral of the force over the contact).
     """
     check_output("--out", out, RESULT_SUFFIXES)
     check_output("--plot", plot, PLOT_SUFFIXES)
@@ -93,11 +109,10 @@ def simulate(
             fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:
             fail(f'--plot: cannot write "{plot}": {exc}', 1)
-    caught = take_warnings()
     if as_json:
-        click.echo(json_text({**metrics, "warnings": caught}))
-    else:
-        click.echo("\n".join([_summary(sc, metrics), *warning_lines(caught)]))
+        click.echo(json_text({**metrics, "warnings": take_warnings()}))
+    else:  # the warnings go to stderr, printed by handle_errors when the command ends
+        click.echo(_summary(sc, metrics))
     for label, path in (("result", out), ("figure", plot)):
         if path is not None:
             click.echo(f"wrote {label} to {path}", err=True)

@@ -20,7 +20,8 @@ Conventions, for figures that go into a paper:
   palette), so they survive grey-scale printing and colour-blindness;
 * legends outside the data area of figures drawn here.
 
-The modules: :mod:`.response` (results), :mod:`.study` (parameter and
+The modules: :mod:`.response` (results), :mod:`.metrics` (the metrics marked on a
+response), :mod:`.study` (parameter and
 convergence studies), :mod:`.modes` (mode shapes), :mod:`.sweep` (sweep
 results), :mod:`.periodic` (bifurcation diagrams, frequency response, maps),
 :mod:`.style` (the journal style), :mod:`.figure` (figure objects, saving).
@@ -31,6 +32,7 @@ below the drivers imports it: the core never needs matplotlib.
 from __future__ import annotations
 
 from .figure import PlotHandles, save_figure
+from .metrics import plot_metrics
 from .modes import plot_modes
 from .periodic import plot_bifurcation, plot_frequency_response, plot_map
 from .response import plot_excitation, plot_response, plot_result, surface_distance
@@ -48,6 +50,7 @@ __all__ = [
     "plot_excitation",
     "plot_frequency_response",
     "plot_map",
+    "plot_metrics",
     "plot_modes",
     "plot_parameter_study",
     "plot_response",

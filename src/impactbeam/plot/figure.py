@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["PlotHandles", "save_figure", "save_and_close", "FIGURE_SUFFIXES"]
+__all__ = ["PlotHandles", "save_figure", "FIGURE_SUFFIXES"]
 
 #: Image formats :func:`save_figure` accepts (by file suffix).
 FIGURE_SUFFIXES = PLOT_SUFFIXES
@@ -123,28 +123,3 @@ def _finish(handles: PlotHandles, path: str | os.PathLike[str] | None, dpi: int 
     if path is not None:
         save_figure(handles.figure, path, dpi=dpi)
     return handles
-
-
-def save_and_close(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 130) -> Path:
-    """Write a pyplot-managed ``figure`` (:func:`save_figure`), then close it in pyplot.
-
-    Parameters
-    ----------
-    figure : matplotlib.figure.Figure
-        A figure made by ``pyplot.subplots``.
-    path : str or path-like
-        The file; its suffix chooses the format.
-    dpi : int
-        Resolution of raster formats.
-
-    Returns
-    -------
-    Path
-    """
-    import matplotlib.pyplot as plt
-
-    try:
-        return save_figure(figure, path, dpi=dpi)
-    finally:
-        plt.close(figure)
-

@@ -3,7 +3,11 @@
 Each function reads its object's attributes only (a
 :class:`~impactbeam.periodic.bifurcation.BifurcationDiagram`, a
 :class:`~impactbeam.periodic.frf.FrequencyResponse`, a map dataset), so this
-package never imports the drivers that make them.
+package never imports the drivers that make them. The figures are in the
+journal style of the package (:mod:`.style`: column widths, 8 pt fonts,
+Okabe-Ito colours with distinct markers, legends outside the data) and are
+bare figures on the Agg canvas, never pyplot's global state; each function
+returns a :class:`~impactbeam.plot.figure.PlotHandles`.
 """
 
 from __future__ import annotations
@@ -13,15 +17,36 @@ from typing import Any
 
 import numpy as np
 
+from .figure import PlotHandles, _finish, _new_figure
+from .style import _outside_legend, _styled, display_label, figure_size, surface_w
+
 __all__ = ["plot_bifurcation", "plot_frequency_response", "plot_map"]
 
+#: (colour, marker) of the two sweep directions: Okabe-Ito blue and vermilion, told apart without colour
+#: by the marker (hollow circles / triangles up for the up sweep, dots / triangles down for the down sweep).
+_SWEEP = {"up": "#0072B2", "down": "#D55E00"}
 
+
+def _legend_handles(*axes: Any) -> tuple[list[Any], list[str]]:
+    handles, labels = [], []
+    for ax in axes:
+        h, lab = ax.get_legend_handles_labels()
+        handles += h
+        labels += lab
+    return handles, labels
+
+
+@_styled
 def plot_bifurcation(diagram: Any, path: str | os.PathLike[str] | None = None, *,
-                     axes: Any = None, scale: float = 1e3) -> Any:
-    """The classic diagram: strobe samples against the parameter, impacts per period beneath.
+                     scale: float = 1e3, x_scale: float | None = None, xlabel: str | None = None,
+                     size: str | tuple[float, float] = "double", dpi: int = 300) -> PlotHandles:
+    """The classic diagram: strobe samples against the parameter, impacts per response period beneath.
 
-    Up and down sweeps are drawn in two colours. Returns the figure; with
-    ``path`` it is also written (and closed).
+    Up sweeps are hollow circles, down sweeps dots (the down sweep shows
+    inside the up sweep's circles where the two agree). In the lower panel a
+    value whose period was found is a dot (impacts per response period), one
+    without a period a cross (the mean impacts per forcing period); all four
+    marks are in the legend.
 
     Parameters
     ----------
@@ -29,57 +54,77 @@ def plot_bifurcation(diagram: Any, path: str | os.PathLike[str] | None = None, *
         From :func:`impactbeam.bifurcation`.
     path : str or path-like, optional
         Write the figure there (format from the suffix).
-    axes : sequence of two matplotlib Axes, optional
-        The strobe panel and the impacts-per-period panel.
     scale : float
         Multiplies w (default 1e3: mm).
+    x_scale : float, optional
+        Multiplies the parameter (default: its display unit, e.g. mm for a gap).
+    xlabel : str, optional
+        Default: the parameter's name with its unit.
+    size : {"single", "double"} or (width, height)
+    dpi : int
+        Resolution of raster files.
+
+    Returns
+    -------
+    PlotHandles
+        ``axes`` = (strobe panel, impacts panel); ``artists["legend"]``.
     """
-    import matplotlib.pyplot as plt
-
-    from .style import display_label
-
-    xlabel, xs = display_label(diagram.parameter, diagram.unit)
-    if axes is None:
-        fig, axes = plt.subplots(2, 1, sharex=True, figsize=(7.0, 5.6), height_ratios=(3, 1), layout="constrained")
-    fig = axes[0].figure
-    colors = {"up": "tab:blue", "down": "tab:orange"}
-    offset = {"up": -0.12, "down": 0.12}
+    label, xs = display_label(diagram.parameter, diagram.unit)
+    xs = xs if x_scale is None else x_scale
+    fig, grid = _new_figure(figure_size(size, 0.62), 2, 1, sharex=True, height_ratios=(3, 1))
+    ax, ax_n = grid[0, 0], grid[1, 0]
     vals = np.array([p.value for p in diagram.points]) * xs
-    step = float(np.min(np.diff(np.unique(vals)))) if np.unique(vals).size > 1 else 1.0
-    for direction in ("up", "down"):
+    uniq = np.unique(vals)
+    step = float(np.min(np.diff(uniq))) if uniq.size > 1 else 1.0
+    lines = []
+    for direction, offset in (("up", -0.12), ("down", 0.12)):
         pts = [p for p in diagram.points if p.direction == direction]
         if not pts:
             continue
+        color = _SWEEP[direction]
         x = np.concatenate([np.full(p.state.strobe.size, p.value * xs) for p in pts])
         y = np.concatenate([p.state.strobe for p in pts]) * scale
-        if direction == "up":  # hollow circles, so the down sweep's dots show inside where they agree
-            axes[0].scatter(x, y, s=10.0, facecolors="none", edgecolors=colors[direction], linewidths=0.6,
-                            label="sweep up")
+        if direction == "up":
+            lines.append(ax.scatter(x, y, s=9.0, facecolors="none", edgecolors=color, linewidths=0.6,
+                                    label="strobe, sweep up"))
         else:
-            axes[0].scatter(x, y, s=2.0, color=colors[direction], linewidths=0, label="sweep down")
-        xi = np.array([p.value for p in pts]) * xs + offset[direction] * step
-        axes[1].plot(xi, [p.state.impacts_per_period if p.state.period else np.nan for p in pts], "o", ms=2.5,
-                     color=colors[direction])
-        bad = [p for p in pts if not p.state.period]
-        if bad:
-            axes[1].plot([p.value * xs for p in bad], [p.state.impacts_per_period for p in bad], "x", ms=3,
-                         color=colors[direction], label=f"{direction}: no period")
-    axes[0].set_ylabel("w at strobe point [mm]" if scale == 1e3 else "w at strobe point")
-    axes[0].legend(loc="best", fontsize="small", markerscale=2)
-    axes[1].set_ylabel("impacts / period")
-    axes[1].set_xlabel(xlabel)
-    if path is not None:
-        from .figure import save_and_close
+            lines.append(ax.scatter(x, y, s=1.5, color=color, linewidths=0, label="strobe, sweep down"))
+        xi = np.array([p.value for p in pts]) * xs + offset * step
+        found = np.array([bool(p.state.period) for p in pts])
+        ipp = np.array([p.state.impacts_per_period for p in pts], dtype=float)
+        ax_n.plot(xi[found], ipp[found], "o", ms=2.0, color=color, ls="none",
+                  label=f"impacts per response period, {direction}")
+        if (~found).any():
+            ax_n.plot(xi[~found], ipp[~found], "x", ms=3.0, mew=0.8, color=color, ls="none",
+                      label=f"no period found: impacts per forcing period, {direction}")
+    unit = "mm" if scale == 1e3 else ("m" if scale == 1.0 else "")
+    ax.set_ylabel(f"w at the strobe point [{unit}]" if unit else "w at the strobe point")
+    ax_n.set_ylabel("impacts /\nperiod")
+    ax_n.set_xlabel(xlabel if xlabel is not None else label)
+    for a in (ax, ax_n):
+        a.grid(True, alpha=0.3)
+    handles, labels = _legend_handles(ax, ax_n)
+    legend = fig.legend(handles, labels, loc="outside lower center", ncols=2, frameon=False, markerscale=1.5)
+    fig.align_ylabels()
+    return _finish(PlotHandles(fig, (ax, ax_n), tuple(lines), {"legend": legend}), path, dpi)
 
-        save_and_close(fig, path)
-    return fig
+
+def _limits(lo: float, hi: float, pad: float = 0.08) -> tuple[float, float]:
+    span = hi - lo if hi > lo else max(abs(hi), 1.0)
+    return lo - pad * span, hi + pad * span
 
 
-def plot_frequency_response(fr: Any, path: str | os.PathLike[str] | None = None, *,
-                            ax: Any = None, scale: float = 1e3, gap: float | None = None) -> Any:
-    """max and min of ``w`` against frequency, up and down sweeps, the linear FRF dashed.
+@_styled
+def plot_frequency_response(fr: Any, path: str | os.PathLike[str] | None = None, *, ax: Any = None,
+                            scale: float = 1e3, contactor: Any = None, size: str | tuple[float, float] = "double",
+                            dpi: int = 300) -> PlotHandles:
+    """max and min of ``w`` against the forcing frequency, up and down sweeps, with the linear FRF dashed.
 
-    Returns the figure; with ``path`` it is written (atomically) and closed.
+    The axis is scaled to the simulated extremes (with a margin), not to the
+    linear resonance: without contact the linear curve's peak is many times
+    the impacting response, and an axis that holds it flattens the impacting
+    branch. Where the linear curve leaves the axis its peak is written on the
+    figure.
 
     Parameters
     ----------
@@ -90,40 +135,67 @@ def plot_frequency_response(fr: Any, path: str | os.PathLike[str] | None = None,
     ax : matplotlib Axes, optional
     scale : float
         Multiplies w (default 1e3: mm).
-    gap : float, optional, [m]
-        Draws the contactor's surface as a horizontal line at this w.
-    """
-    import matplotlib.pyplot as plt
+    contactor : Contactor, optional
+        Draws its surface as a horizontal line at its ``w``: ``-gap`` for a
+        contactor ``below`` the beam, ``+gap`` above (it should be the
+        contactor at the strobe point ``fr.point``).
+    size : {"single", "double"} or (width, height)
+    dpi : int
+        Resolution of raster files.
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(7.0, 4.4), layout="constrained")
+    Returns
+    -------
+    PlotHandles
+        ``artists`` holds ``"surface"`` (the line, or None), ``"linear_peak"``
+        (the note of an off-scale linear peak, or None) and ``"legend"``.
+    """
+    own = ax is None
+    if own:
+        fig, grid = _new_figure(figure_size(size, 0.55))
+        ax = grid[0, 0]
     fig = ax.figure
     order = np.argsort(fr.frequency, kind="stable")
     fs = fr.frequency[order]
-    ax.plot(fs, fr.linear[order] * scale, "k--", lw=0.8, label="linear FRF |H| A (no contact)")
-    ax.plot(fs, -fr.linear[order] * scale, "k--", lw=0.8)
-    for direction, color, mk in (("up", "tab:blue", "^"), ("down", "tab:orange", "v")):
+    lin = fr.linear[order] * scale
+    (l_lin,) = ax.plot(fs, lin, color="#000000", ls="--", lw=0.8, label="linear FRF |H| A (no contact)")
+    ax.plot(fs, -lin, color="#000000", ls="--", lw=0.8)
+    lines = [l_lin]
+    for direction, mk in (("up", "^"), ("down", "v")):
         m = fr.direction == direction
         if m.any():
-            ax.plot(fr.frequency[m], fr.max[m] * scale, mk, ms=3, color=color, label=f"max, sweep {direction}")
-            ax.plot(fr.frequency[m], fr.min[m] * scale, mk, ms=3, color=color, mfc="none",
-                    label=f"min, sweep {direction}")
-    if gap is not None:
-        ax.axhline(gap * scale, color="0.5", lw=0.8, ls=":", label="gap")
+            color = _SWEEP[direction]
+            lines += ax.plot(fr.frequency[m], fr.max[m] * scale, mk, ms=2.5, color=color, ls="none",
+                             label=f"max, sweep {direction}")
+            lines += ax.plot(fr.frequency[m], fr.min[m] * scale, mk, ms=2.5, color=color, mfc="none", mew=0.6,
+                             ls="none", label=f"min, sweep {direction}")
+    art: dict[str, Any] = {"surface": None, "linear_peak": None}
+    ys = [fr.max * scale, fr.min * scale]
+    if contactor is not None:
+        w_s = surface_w(contactor) * scale
+        side = "+gap" if w_s > 0 else "-gap" if w_s < 0 else "0"
+        art["surface"] = ax.axhline(w_s, color="0.45", lw=0.8, ls=":", label=f"contactor surface, w = {side}")
+        ys.append(np.array([w_s]))
+    finite = np.concatenate([y[np.isfinite(y)] for y in ys])
+    lo, hi = _limits(float(finite.min()), float(finite.max())) if finite.size else (-1.0, 1.0)
+    ax.set_ylim(lo, hi)
+    k = int(np.argmax(lin)) if lin.size else 0
+    if lin.size and lin[k] > hi:
+        art["linear_peak"] = ax.annotate(
+            f"linear peak {lin[k]:.3g} mm\nat {fs[k]:.4g} Hz (off scale)" if scale == 1e3 else
+            f"linear peak {lin[k]:.3g} at {fs[k]:.4g} Hz (off scale)",
+            xy=(fs[k], hi), xytext=(6, -4), textcoords="offset points", ha="left", va="top")
     ax.set_xlabel("forcing frequency [Hz]")
-    ax.set_ylabel("w at the strobe point [mm]" if scale == 1e3 else "w at the strobe point")
-    ax.legend(fontsize="small", loc="best")
-    if path is not None:
-        from .figure import save_and_close
-
-        save_and_close(fig, path)
-    return fig
+    where = f"x = {fr.point * 1e3:.4g} mm" if np.isfinite(fr.point) else "the strobe point"
+    ax.set_ylabel(f"w at {where} [mm]" if scale == 1e3 else f"w at {where}")
+    ax.grid(True, alpha=0.3)
+    art["legend"] = _outside_legend(fig, ax, ncols=3) if own else ax.legend(fontsize="small", loc="best")
+    return _finish(PlotHandles(fig, (ax,), tuple(lines), art), path, dpi)
 
 
-def plot_map(ds: Any, path: str | os.PathLike[str] | None = None) -> Any:
+@_styled
+def plot_map(ds: Any, path: str | os.PathLike[str] | None = None, *, size: str | tuple[float, float] = "double",
+             dpi: int = 300) -> PlotHandles:
     """Two panels over (x, y): the response period (0: none found) and the impacts per period.
-
-    Returns the figure; with ``path`` it is written (atomically) and closed.
 
     Parameters
     ----------
@@ -131,19 +203,25 @@ def plot_map(ds: Any, path: str | os.PathLike[str] | None = None) -> Any:
         From :func:`impactbeam.bifurcation_map`.
     path : str or path-like, optional
         Write the figure there (format from the suffix).
+    size : {"single", "double"} or (width, height)
+    dpi : int
+        Resolution of raster files.
+
+    Returns
+    -------
+    PlotHandles
     """
-    import matplotlib.pyplot as plt
+    from matplotlib import colormaps
 
-    from .style import display_label
-
-    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.0), sharey=True, layout="constrained")
+    fig, grid = _new_figure(figure_size(size, 0.42), 1, 2, sharey=True)
+    axes = grid[0]
     xlabel, xs = display_label(ds.attrs["x_parameter"], ds["x"].attrs.get("units"))
     ylabel, ys = display_label(ds.attrs["y_parameter"], ds["y"].attrs.get("units"))
     x, y = ds["x"].values * xs, ds["y"].values * ys
     period = np.where(ds["done"].values[:, None], ds["period"].values, -1).astype(float)
     period[period < 0] = np.nan
     top = max(2, int(np.nanmax(period)) if np.isfinite(period).any() else 2)
-    cmap = plt.get_cmap("tab10", top + 1)
+    cmap = colormaps["tab10"].resampled(top + 1)
     m0 = axes[0].pcolormesh(x, y, period, shading="nearest", cmap=cmap, vmin=-0.5, vmax=top + 0.5)
     fig.colorbar(m0, ax=axes[0], label="period (0: none found)", ticks=range(top + 1))
     m1 = axes[1].pcolormesh(x, y, ds["impacts_per_period"].values, shading="nearest", cmap="viridis")
@@ -151,8 +229,4 @@ def plot_map(ds: Any, path: str | os.PathLike[str] | None = None) -> Any:
     for ax in axes:
         ax.set_xlabel(xlabel)
     axes[0].set_ylabel(ylabel)
-    if path is not None:
-        from .figure import save_and_close
-
-        save_and_close(fig, path)
-    return fig
+    return _finish(PlotHandles(fig, tuple(axes), (), {"period": m0, "impacts_per_period": m1}), path, dpi)

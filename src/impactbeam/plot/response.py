@@ -38,6 +38,7 @@ from .style import (
     _outside_legend,
     _response_label,
     rc_context,
+    surface_w,
     _side_legend,
     _style,
     _styled,
@@ -212,7 +213,7 @@ def plot_result(
     artists: dict[str, Any] = {"contact_spans": [], "impacts": None, "rebounds": None, "surface": None}
     if has_c:
         c = result.contactors[0]
-        ysurf = -c.gap if quantity != "w" else c.direction * c.gap
+        ysurf = -c.gap if quantity != "w" else surface_w(c)
         artists["surface"] = ax_w.axhline(ysurf * _MM, color="0.4", ls=(0, (4, 2)), lw=0.8, label="contactor surface")
         t_end = float(t[-1])
         for k, (a, b) in enumerate(contact_intervals(result, 0)):

@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["SERIES_STYLES", "STYLE", "WIDTHS", "figure_size"]
+__all__ = ["SERIES_STYLES", "STYLE", "WIDTHS", "figure_size", "surface_w"]
 
 _G = 9.80665
 
@@ -72,6 +72,17 @@ def figure_size(size: str | tuple[float, float] = "double", aspect: float = 0.5)
     if size not in WIDTHS:
         raise ParameterError(f'size: must be "single", "double" or (width, height) in inches, got {size!r}')
     return WIDTHS[size], WIDTHS[size] * aspect
+
+
+def surface_w(contactor: Any) -> float:
+    """The deflection ``w`` [m] of a contactor's surface: ``+gap`` above the beam, ``-gap`` below.
+
+    Parameters
+    ----------
+    contactor : Contactor
+        Its ``gap`` and ``direction`` (+1 above, -1 below).
+    """
+    return float(contactor.direction * contactor.gap)
 
 
 def _style(i: int) -> dict[str, Any]:
@@ -139,8 +150,10 @@ def display_label(name: str, units: str | None) -> tuple[str, float]:
     short = parts[-1].replace("_", " ")
     if len(parts) == 3 and parts[0] == "contactors" and parts[1] != "0":
         short += f" (contactor {parts[1]})"
-    elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("duration", "amplitude", "scale", "start"):
+    elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("duration", "start"):
         short = f"pulse {short}"
+    elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("amplitude", "scale"):
+        short = f"load {short}"  # a pulse's or a harmonic load's
     elif len(parts) == 2 and parts[0] == "excitation" and parts[1] in ("frequency", "phase"):
         short = f"forcing {short}"
     elif len(parts) == 2 and parts[0] == "damping":

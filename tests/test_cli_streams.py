@@ -1,0 +1,76 @@
+"""Output streams of the commands: results on stdout, warnings on stderr (and in ``--json``'s "warnings").
+
+A table on stdout is what scripts read (``impactbeam bifurcation ... > table.txt``); a warning line
+among its rows breaks them and is lost in the file. Every command prints its ImpactBeamWarnings on
+stderr as ``warning: ...`` lines, once, when it ends; with ``--json`` they are the "warnings" list of
+the JSON instead, and stdout is the JSON alone. Run as subprocesses, as a user runs them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import impactbeam as ib
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+
+def _run(*args: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run([sys.executable, "-m", "impactbeam", *args], capture_output=True, text=True, env=env,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return proc
+
+
+def _warning_lines(text: str) -> list[str]:
+    return [ln for ln in text.splitlines() if ln.startswith("warning:")]
+
+
+#: Two forcing frequencies in the specimen's window without a period (docs/periodic.md), with short
+#: settling so that no period is found: each value warns.
+BIFURCATION = [str(EXAMPLES / "periodic" / "specimen_harmonic.toml"), "--parameter", "excitation.frequency",
+               "--values", "64 Hz,64.25 Hz", "--settle-periods", "4", "--record-periods", "4"]
+
+
+def test_bifurcation_table_on_stdout_warnings_on_stderr():
+    proc = _run("bifurcation", *BIFURCATION)
+    out = proc.stdout.splitlines()
+    assert out[0].startswith("bifurcation over excitation.frequency") and len(out) == 2 + 2  # title, header, 2 rows
+    assert not _warning_lines(proc.stdout)
+    warned = _warning_lines(proc.stderr)
+    assert len(warned) == 2 and all("no period" in ln for ln in warned), proc.stderr
+
+
+def test_bifurcation_json_carries_the_warnings_and_nothing_else_on_stdout():
+    proc = _run("bifurcation", *BIFURCATION, "--json")
+    data = json.loads(proc.stdout)  # stdout is the JSON alone
+    assert len(data["warnings"]) == 2 and all("no period" in w for w in data["warnings"])
+    assert not _warning_lines(proc.stderr)  # reported once, in the JSON
+
+
+@pytest.fixture(scope="module")
+def warning_scenario(tmp_path_factory) -> Path:
+    # The zero-gap Case 9 with the paper's basis and 2 modes: the projection at the switches moves the
+    # contactor by more than 5 % of its deflection, and the run says so (an ImpactBeamWarning).
+    sc = ib.load_scenario(EXAMPLES / "case09.toml").with_values({"solver.basis": "paper", "solver.modes": 2})
+    path = tmp_path_factory.mktemp("streams") / "case09_2modes.toml"
+    path.write_text(sc.to_toml())
+    return path
+
+
+def test_simulate_summary_on_stdout_warnings_on_stderr(warning_scenario):
+    proc = _run("simulate", str(warning_scenario))
+    assert proc.stdout.startswith("Simulation of") and not _warning_lines(proc.stdout)
+    assert any("too stiff for this number of modes" in ln for ln in _warning_lines(proc.stderr)), proc.stderr
+    proc = _run("simulate", str(warning_scenario), "--json")
+    data = json.loads(proc.stdout)
+    assert any("too stiff for this number of modes" in w for w in data["warnings"])
+    assert not _warning_lines(proc.stderr)
