@@ -74,18 +74,6 @@ def test_restitution_published_values_and_inverse():
         assert restitution_of(restitution_ratio(e)) == pytest.approx(e, rel=1e-12)
 
 
-def test_the_restitution_table_of_the_docs():
-    # docs/dissipation.md shows e against xi: every row is what restitution_ratio gives (4 decimals)
-    from pathlib import Path
-
-    text = (Path(__file__).resolve().parents[1] / "docs" / "dissipation.md").read_text(encoding="utf-8")
-    rows = [line.strip("| ").split(" | ") for line in text.splitlines()
-            if line.startswith("| 0.") or line.startswith("| 1 |")]
-    assert len(rows) == 11
-    for e, xi in rows:
-        assert f"{restitution_ratio(float(e)):.4f}" == xi
-
-
 def test_restitution_of_a_nearly_rigid_beam():
     # A very stiff free-free beam dropped flat onto a soft stop at its middle is a rigid
     # mass on a spring-dashpot: the rebound speed over the approach speed is e. The

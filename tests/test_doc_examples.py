@@ -260,6 +260,14 @@ def _mode_table(case: str, basis: str | None) -> tuple[dict, dict]:
             for n in (2, 4, 8, 16)}, {}
 
 
+@_producer(TABLES, "restitution")
+def _restitution():
+    from impactbeam.solver.damping import restitution_ratio
+
+    es = (0.95, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1, 0.05)
+    return {f"{e:g}": {"ξ": restitution_ratio(e)} for e in es}, {}
+
+
 TABLES["modes-case12"] = functools.cache(lambda: _mode_table("case12", None))
 TABLES["modes-case03"] = functools.cache(lambda: _mode_table("case03", None))
 TABLES["modes-case12-paper"] = functools.cache(lambda: _mode_table("case12", "paper"))
