@@ -62,6 +62,8 @@ class Scenario:
         Fields of result files (``[output] fields``, canonical names):
         ``displacement`` and ``velocity`` (always written), ``moment`` and
         ``stress`` (which also adds its maximum to the metrics).
+    fatigue : FatigueSpec or None
+        ``[fatigue]``: the points and S-N curve of the fatigue statistics.
     """
 
     beam: Beam
