@@ -109,7 +109,8 @@ class RandomResponse:
 
 
 def _interval(lo: Any, hi: Any) -> list[float]:
-    return [float(lo), float(hi)]
+    """An interval of a non-negative quantity: the Student-t bounds, the lower one at least 0."""
+    return [max(float(lo), 0.0) if np.isfinite(lo) else float(lo), float(hi)]
 
 
 def _aggregate(ds: xr.Dataset, confidence: float, has_fatigue: bool) -> dict[str, Any]:
