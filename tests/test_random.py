@@ -1,0 +1,179 @@
+"""Random loads: the density, its synthesis, and the linear response against the exact modes.
+
+Independent values: log-log interpolation and its closed-form integral
+against scipy's quadrature; the synthesised history's density against the
+target within Welch's chi-squared band; the deflection and velocity RMS of a
+linear run against ``int |H|^2 G df`` from the exact modes (random_cases.py).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import impactbeam as ib
+from impactbeam.cli import main
+from impactbeam.model.psd import PowerSpectralDensity, synthesize
+from impactbeam.statistics import response_statistics, welch_psd
+from impactbeam.units import STANDARD_GRAVITY, to_si
+from random_cases import BAND, LinearReference, linear_data
+
+
+def test_log_log_interpolation_and_exact_integral():
+    from scipy.integrate import quad
+
+    psd = PowerSpectralDensity([10.0, 100.0, 1000.0], [0.01, 0.01, 0.001])
+    # a straight line on log-log axes: the geometric mean of the ends at the geometric mean frequency
+    assert psd(np.sqrt(100.0 * 1000.0))[0] == pytest.approx(np.sqrt(0.01 * 0.001), rel=1e-14)
+    assert psd([5.0, 10.0, 1000.0, 1000.1]).tolist() == [0.0, 0.01, 0.001, 0.0]  # zero outside the table
+    # tolerance 1e-9: the adaptive quadrature's own accuracy (the closed form is exact)
+    ref = quad(lambda f: psd(f)[0], 10.0, 1000.0, points=[100.0], epsabs=0, epsrel=1e-12, limit=200)[0]
+    assert psd.variance() == pytest.approx(ref, rel=1e-9)
+    # b = -1 (G ~ 1/f): the logarithmic case of the closed form
+    inv = PowerSpectralDensity([10.0, 1000.0], [1.0, 0.01])
+    assert inv.variance() == pytest.approx(10.0 * np.log(100.0), rel=1e-13)
+    # a zero level makes its segments zero (the limit of the log-log line)
+    edge = PowerSpectralDensity([10.0, 20.0, 40.0], [0.0, 1.0, 1.0])
+    assert edge(15.0)[0] == 0.0 and edge(20.0)[0] == 1.0 and edge.variance() == pytest.approx(20.0, rel=1e-14)
+    assert edge.band == (20.0, 40.0)
+
+
+def test_spectral_density_units():
+    assert to_si("0.01 g^2/Hz", "acceleration_psd", "k") == pytest.approx(0.01 * STANDARD_GRAVITY**2, rel=1e-15)
+    assert to_si("2 N^2/Hz", "force_psd", "k") == 2.0
+    assert to_si("1 (N/m)^2/Hz", "force_per_length_psd", "k") == 1.0
+    with pytest.raises(ib.ScenarioError, match=r"excitation\.psd\.0\.1: .*velocity.*spectral density"):
+        to_si("0.01 g/Hz", "acceleration_psd", "excitation.psd.0.1")
+
+
+def test_synthesis_repeats_bit_for_bit_and_streams_are_spawned_children():
+    psd = PowerSpectralDensity(list(BAND), [1.0, 1.0])
+    a = synthesize(psd, 5.0, 42)[1]
+    assert np.array_equal(a, synthesize(psd, 5.0, 42)[1])
+    assert not np.array_equal(a, synthesize(psd, 5.0, 43)[1])
+    s2 = synthesize(psd, 5.0, 42, stream=2)[1]
+    assert not np.array_equal(a, s2)
+    # the stream is the child of SeedSequence.spawn: the same state words
+    child = np.random.SeedSequence(42).spawn(3)[2]
+    assert np.array_equal(child.generate_state(4), np.random.SeedSequence(42, spawn_key=(2,)).generate_state(4))
+    assert a[0] == a[-1]  # periodic record: the last sample repeats the first
+    assert abs(np.mean(a[:-1])) < 1e-12 * np.std(a)  # no line at 0 Hz: zero mean
+
+
+def test_synthesised_density_within_its_chi2_band():
+    """The held history (what the solver integrates) has the target density in the band."""
+    sc = ib.parse_scenario(linear_data(end_time=60.0))
+    ex = sc.excitation
+    fs_load = 1.0 / float(ex.times[1] - ex.times[0])
+    rate = 4.0 * fs_load  # the hold's images (near fs_load) stay far above the tested band
+    t = np.arange(int(60.0 * rate)) / rate
+    u = ex.history(t)
+    est = welch_psd(u, rate, segment=int(rate))  # 1 Hz bins, ~115 degrees of freedom
+    lo, hi = welch_psd(u, rate, segment=int(rate), confidence=0.99)["band"]
+    f = est["frequency"]
+    inside = (f >= 1.5 * BAND[0]) & (f <= BAND[1] / 1.1)
+    target = ex.psd(f[inside])
+    ratio = est["psd"][inside] / target
+    # tolerance: a Gaussian estimate leaves the 99 % band in 1 % of the bins; random phases with
+    # exact line amplitudes scatter less (measured: none outside); allow 2 %
+    assert np.mean((ratio < lo) | (ratio > hi)) <= 0.02
+    # the level itself: the mean over ~250 bins within 1 % (the scatter of a mean of 250 estimates)
+    assert np.mean(ratio) == pytest.approx(1.0, abs=0.01)
+    # variance of the history against int G df: the lines are a Riemann sum of the integral (error
+    # ~ 1/(60 s * 290 Hz)), the hold's images add (f/fs)^4-weighted power: both below 0.5 %
+    assert np.var(u) == pytest.approx(ex.psd.variance(), rel=5e-3)
+
+
+def test_linear_rms_against_the_exact_modes():
+    """Deflection and velocity RMS of a linear run against int |H|^2 G df (exact modes).
+
+    Statistical error stated: over random phases the window's mean square scatters around the
+    line sum with the relative standard deviation of LinearReference.window_std (~0.9 % here);
+    the tolerance is four of those (plus the line sum against the integral, ~1e-5, and the
+    start-up residue, below 1e-3 by the settling time).
+    """
+    sc = ib.parse_scenario(linear_data(end_time=40.0))
+    ref = LinearReference(sc)
+    res = ib.simulate(sc)
+    stats = response_statistics(res)
+    lo, hi = stats["window"]
+    assert lo > 0.5  # the start from rest is left out
+    for velocity, key in ((False, "rms"), (True, "rms_velocity")):
+        exact = ref.variance(velocity)
+        tol = 4 * ref.window_std(40.0, hi - lo, velocity) + 1e-3
+        for got, want, rtol in zip(np.array(stats[key]) ** 2, exact, tol):
+            assert got == pytest.approx(want, rel=rtol)
+
+
+def test_random_scenario_keys_and_drawn_seed(scenario_file):
+    data = linear_data(end_time=2.0)
+    del data["excitation"]["seed"]
+    sc = ib.parse_scenario(data)
+    seed = sc.excitation.seed
+    assert sc.excitation.seed_drawn and sc.data["excitation"]["seed"] == seed  # kept: runs repeat
+    again = ib.parse_scenario(sc.data)
+    assert np.array_equal(again.excitation.values, sc.excitation.values)
+    text = sc.to_toml()
+    assert f"seed = {seed}" in text
+    path = scenario_file(ib.parse_scenario(data).to_toml().replace("seed = ", "# seed = "), "noseed.toml")
+    out = CliRunner().invoke(main, ["simulate", str(path), "--json"], catch_exceptions=False)
+    assert out.exit_code == 0
+    assert isinstance(json.loads(out.stdout)["seed"], int)  # the drawn seed is reported
+
+
+BAD = [
+    ('psd = [["20 Hz", "0.01 g^2/Hz"], ["10 Hz", "0.01 g^2/Hz"]]', "excitation.psd.1.0", "increase"),
+    ('psd = [["10 Hz", "-0.01 g^2/Hz"], ["100 Hz", "0.01 g^2/Hz"]]', "excitation.psd.0.1", "zero or positive"),
+    ('psd = [["10 Hz", "0.01 g"], ["100 Hz", "0.01 g^2/Hz"]]', "excitation.psd.0.1", "spectral density"),
+    ('psd = [["10 s", "0.01 g^2/Hz"], ["100 Hz", "0.01 g^2/Hz"]]', "excitation.psd.0.0", "frequency"),
+    ('psd = [["10 Hz", "0.01 g^2/Hz"]]', "excitation.psd", "two"),
+    ('psd = [[10, 0.1, 3], [100, 0.1]]', "excitation.psd.0", "row of 2"),
+    ('psd = [[10, 0.1], [100, 0.1]]\nseed = -1', "excitation.seed", ">= 0"),
+    ('psd = [[10, 0.1], [100, 0.1]]\namplitude = "1 g"', "excitation.amplitude", "no effect"),
+    ('psd = [[10, 0.1], [100, 0.1]]\nsample_rate = "150 Hz"', "excitation.sample_rate", "twice"),
+]
+BAD_FATIGUE = [
+    ('points = [0.2]\nsn_stress = "20 MPa"\nsn_cycles = 1e6\nsn_exponent = 8', "fatigue.points.0", "off the beam"),
+    ('points = [0.0]\nsn_stress = "20 MPa"\nsn_cycles = 1e6\nsn_exponent = 0', "fatigue.sn_exponent", "positive"),
+    ('points = [0.0]\nsn_stress = "20 MPa"\nsn_cycles = 1e6\nsn_exponent = -3', "fatigue.sn_exponent", "positive"),
+    ('points = [0.0]\nsn_stress = "20 mm"\nsn_cycles = 1e6\nsn_exponent = 8', "fatigue.sn_stress", "stress"),
+    ('points = [0.0]\nsn_stress = "20 MPa"\nsn_cycles = 1e6\nsn_exponent = 8\nmean_stress = "goodman"',
+     "fatigue.ultimate_strength", "required"),
+    ('points = [0.0]\nsn_stress = "20 MPa"\nsn_exponent = 8', "fatigue.sn_cycles", "required"),
+]
+
+_HEAD = """
+[beam]
+length = 0.1092
+width = 9.93e-3
+height = 3.03e-3
+youngs_modulus = 1834e6
+density = 951.98
+[solver]
+modes = 2
+end_time = 0.5
+"""
+
+
+@pytest.mark.parametrize("lines,key,words", BAD + BAD_FATIGUE)
+def test_bad_random_and_fatigue_input_exits_2_naming_the_key(scenario_file, lines, key, words):
+    if key.startswith("fatigue"):
+        text = _HEAD + '[excitation]\nkind = "base_acceleration"\nshape = "half_sine"\namplitude = "1 g"\n' \
+            'duration = "5 ms"\n[fatigue]\n' + lines + "\n"
+    else:
+        text = _HEAD + '[excitation]\nkind = "base_acceleration"\nshape = "random"\n' + lines + "\n"
+    path = scenario_file(text)
+    out = CliRunner().invoke(main, ["simulate", str(path)], catch_exceptions=False)
+    assert out.exit_code == 2, out.output
+    line = out.stderr.strip()
+    assert line.count("\n") == 0 and line.startswith(f"error: {key}:"), line
+    assert words in line
+
+
+def test_psd_keys_only_with_a_random_shape(scenario_file):
+    text = _HEAD + '[excitation]\nkind = "base_acceleration"\nshape = "step"\namplitude = 1\nseed = 3\n'
+    out = CliRunner().invoke(main, ["simulate", str(scenario_file(text))], catch_exceptions=False)
+    assert out.exit_code == 2 and out.stderr.startswith("error: excitation.seed:")
