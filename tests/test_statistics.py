@@ -247,3 +247,18 @@ def test_sweep_over_gap_and_level_stores_the_statistics():
     assert got == alone["rate"]
     rates = ds["impact_rate"].values[..., 0]
     assert rates[0, 1] > rates[1, 1] and rates[1, 1] > rates[1, 0]  # closer or harder: more impacts
+
+
+def test_random_figures(tmp_path):
+    pytest.importorskip("matplotlib")
+    from impactbeam.plot.random import plot_input_psd, plot_random
+
+    data = linear_data(end_time=3.0, points=(0.1092,))
+    data["contactors"] = [{"position": 0.1092, "stiffness": 4030, "gap": "0.4 mm", "side": "below"}]
+    res = ib.simulate(ib.parse_scenario(data))
+    h = plot_random(res, path=tmp_path / "random.png", dpi=80)
+    assert len(h.axes) == 4 and (tmp_path / "random.png").stat().st_size > 10_000
+    assert [ax.get_xlabel() for ax in h.axes] == ["frequency [Hz]", "frequency [Hz]", "peak impact force [N]",
+                                                  "stress range at x = 0 mm [MPa]"]
+    with pytest.raises(ib.ParameterError, match="random"):
+        plot_input_psd(_harmonic_scenario().excitation)

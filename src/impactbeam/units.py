@@ -237,6 +237,7 @@ COMMON_UNITS: dict[tuple[str, str], float] = {
     **{(u, "stress"): f for u, f in (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9))},
     **{(u, "acceleration_psd"): f for u, f in (("g^2/Hz", STANDARD_GRAVITY**2), ("(m/s^2)^2/Hz", 1.0))},
     ("N^2/Hz", "force_psd"): 1.0,
+    **{(u, "frequency"): f for u, f in (("Hz", 1.0), ("kHz", 1e3))},
 }
 _FACTORS: dict[tuple[str, str], float] = {}
 
