@@ -107,8 +107,12 @@ def throughput(duration: float, fmax: float, repeats: int) -> None:
     print("\n".join(line for line in out.getvalue().splitlines() if line.strip())[-1200:])
 
 
-def rate_evidence(fmax: float, duration: float = 10.0) -> None:
-    """The same record at 4, 8, 16 and 32 f_max: changes against 32 f_max."""
+#: Quantities of the sample-rate evidence, in the order of :func:`rate_changes`.
+RATE_NAMES = ["rms w(a)", "rms w(L)", "rms w_t(a)", "rms w_t(L)", "rms stress(0)", "impact rate", "force rms"]
+
+
+def rate_changes(fmax: float = 1000.0, duration: float = 10.0) -> dict[int, np.ndarray]:
+    """The same record at 4, 8, 16 and 32 f_max: relative changes against 32 f_max (RATE_NAMES order)."""
     rows = {}
     for factor in (4, 8, 16, 32):
         sc = random_case(duration, fmax, rate=factor * fmax)
@@ -121,11 +125,15 @@ def rate_evidence(fmax: float, duration: float = 10.0) -> None:
             stress = res.bending_stress([0.0], t)[0]
         rows[factor] = np.array([*rs["rms"], *rs["rms_velocity"], float(np.sqrt(np.mean(stress**2))),
                                  imp.contactors[0]["rate"], imp.contactors[0]["force_rms"]])
-    names = ["rms w(a)", "rms w(L)", "rms w_t(a)", "rms w_t(L)", "rms stress(0)", "impact rate", "force rms"]
+    return {f: rows[f] / rows[32] - 1.0 for f in (4, 8, 16)}
+
+
+def rate_evidence(fmax: float, duration: float = 10.0) -> None:
+    """Print :func:`rate_changes` (the table of docs/random-vibration.md)."""
+    changes = rate_changes(fmax, duration)
     print(f"load sample rate (same lines and phases, {duration:g} s, f_max = {fmax:g} Hz): change against 32 f_max")
-    print("  " + "".join(f"{n:>14}" for n in names))
-    for factor in (4, 8, 16):
-        rel = rows[factor] / rows[32] - 1.0
+    print("  " + "".join(f"{n:>14}" for n in RATE_NAMES))
+    for factor, rel in changes.items():
         print(f"  {factor:>2} f_max" + "".join(f"{100 * r:13.3f}%" for r in rel))
 
 

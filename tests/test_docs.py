@@ -28,9 +28,9 @@ def _kernel_env() -> None:
     os.environ.setdefault("MPLBACKEND", "Agg")
 
 
-def test_there_are_four_tutorials() -> None:
+def test_there_are_five_tutorials() -> None:
     names = {p.stem for p in NOTEBOOKS}
-    assert names == {"first-simulation", "parameter-study", "identification", "paper-reproduction"}
+    assert names == {"first-simulation", "parameter-study", "identification", "paper-reproduction", "random-vibration"}
 
 
 def test_notebooks_are_generated_from_the_script_and_stored_without_outputs() -> None:

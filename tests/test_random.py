@@ -177,3 +177,46 @@ def test_psd_keys_only_with_a_random_shape(scenario_file):
     text = _HEAD + '[excitation]\nkind = "base_acceleration"\nshape = "step"\namplitude = 1\nseed = 3\n'
     out = CliRunner().invoke(main, ["simulate", str(scenario_file(text))], catch_exceptions=False)
     assert out.exit_code == 2 and out.stderr.startswith("error: excitation.seed:")
+
+
+def test_numbers_of_the_random_vibration_page():
+    """docs/random-vibration.md: the numbers it shows, from the shipped code."""
+    from pathlib import Path
+
+    from impactbeam.model.psd import MIN_LINES, RATE_FACTOR
+    from impactbeam.statistics import settling_time
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "random-vibration.md").read_text()
+    sigma = PowerSpectralDensity([10.0, 1000.0], [0.01, 0.01]).rms()  # in g
+    assert f"= {sigma:.2f}\\,g" in text
+    assert RATE_FACTOR == 8 and "$f_s = 8 f_{max}$" in text and f"(1/{RATE_FACTOR - 1:g})^4" in text
+    assert f"fewer than {MIN_LINES} lines" in text
+    case3 = ib.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "case03.toml")
+    sc = case3.with_values({"excitation.shape": "random", "excitation.amplitude": None, "excitation.duration": None,
+                            "excitation.psd": [[10, 0.1], [1000, 0.1]], "excitation.seed": 1,
+                            "solver.end_time": 0.05})
+    res = ib.simulate(sc)
+    assert f"{settling_time(res):.2f} s for Case 3's beam" in text
+    f1 = ib.modes(case3).free.omega[0] / (2 * np.pi)
+    assert f"{100 * case3.damping.free:.1f} % damping of its {f1:.0f} Hz first mode" in text
+
+
+@pytest.mark.slow
+def test_sample_rate_evidence_of_the_random_vibration_page():
+    """The table of docs/random-vibration.md, recomputed (benchmarks/bench_random.py --rates).
+
+    The entries are shown as bounds: a record with impacts is sensitive to the last bit of its
+    load (a changed bit moves an impact), so the impact rate and force RMS at 4 f_max are bounded
+    by 1 % (measured 0.4-0.6 %: 2-3 of ~450 impacts) rather than given to more digits."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    try:
+        from bench_random import rate_changes
+    finally:
+        sys.path.pop(0)
+    ch = {f: 100 * np.abs(v) for f, v in rate_changes(1000.0, 10.0).items()}
+    assert np.all(ch[8] <= 0.01) and np.all(ch[16] <= 0.01)
+    assert np.all(ch[4][:4] <= 0.04) and ch[4][4] <= 0.02
+    assert ch[4][5] < 1.0 and ch[4][6] < 1.0

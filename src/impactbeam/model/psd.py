@@ -57,8 +57,8 @@ __all__ = ["PowerSpectralDensity", "synthesize", "sample_rate", "RATE_FACTOR", "
 #: Chosen on evidence (benchmarks/bench_random.py --rates, docs/random-vibration.md): one 10 s record on
 #: Case 3's beam with its stop under 10-1000 Hz, the same lines and phases sampled at 4, 8, 16 and 32 f_max
 #: (a deterministic comparison). Against 32 f_max, at 8 f_max the RMS deflection, velocity and root stress,
-#: the impact rate and the force RMS change by less than 0.005 %; at 4 f_max by up to 0.03 % (RMS values),
-#: 0.4 % (impact rate: 2 of 425 impacts) and 0.3 % (force RMS), while the hold's images grow from 4e-4 to
+#: the impact rate and the force RMS change by less than 0.01 %; at 4 f_max by up to 0.04 % (RMS values)
+#: and under 1 % (impact rate: 2-3 of ~450 impacts; force RMS), while the hold's images grow from 4e-4 to
 #: 1.2 % of the density. 8 keeps the sampling's share far below a record's statistical error on beams whose
 #: modes sit near the images; ``excitation.sample_rate`` can halve the cost where that is shown not to matter.
 RATE_FACTOR = 8.0
