@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -200,6 +201,11 @@ def _parse_fatigue(raw: Mapping[str, Any], beam: Beam) -> FatigueSpec | None:
         raise ScenarioError("fatigue.points: the list is empty", key="fatigue.points")
     points = tuple(_on_beam(f"fatigue.points.{i}", to_si(v, "length", f"fatigue.points.{i}"), beam.length)
                    for i, v in enumerate(fat["points"]))
+    for i, x in enumerate(points):
+        if not math.isfinite(float(beam.fibre_distance_at([x])[0])):
+            raise ScenarioError(
+                f"fatigue.points.{i}: the section there is given by area and second_moment, so its outer-fibre "
+                "distance (and the bending stress) is unknown; give width and height", key=f"fatigue.points.{i}")
     for name in ("sn_stress", "sn_cycles", "sn_exponent"):
         _required(fat, "fatigue", name, " (the S-N curve N(S) = sn_cycles (S / sn_stress)^-sn_exponent)")
     kw: dict[str, Any] = {

@@ -54,7 +54,7 @@ _REFINE = 1e-6  # final bracket of the golden-section search over its initial tw
 def _stress(result: Any, x: float, t: np.ndarray) -> np.ndarray:
     out = np.empty(t.size)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ImpactBeamWarning)  # the plain-sum warning is said by the caller's run
+        warnings.simplefilter("ignore", ImpactBeamWarning)  # the plain-sum warning: said once by fatigue_statistics
         for a in range(0, t.size, _CHUNK):
             out[a : a + _CHUNK] = result.bending_stress([x], t[a : a + _CHUNK])[0]
     return out
@@ -217,6 +217,12 @@ def fatigue_statistics(result: ResultLike, spec: FatigueSpec | None = None,
     if spec is None:
         return []
     lo, hi = analysis_window(result, window)
+    packed = getattr(result.solution, "packed", None)
+    if packed is not None and packed.space.state(()).modes.n_rigid:
+        from .._warnings import emit_user_level_warning
+
+        emit_user_level_warning("fatigue: the stress is the plain modal sum (no static correction for a beam that "
+                                "can move as a rigid body); it converges slowly near loads and stops")
     out = []
     for x in spec.points:
         _, values = stress_turning_points(result, x, lo, hi)

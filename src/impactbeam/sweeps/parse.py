@@ -223,6 +223,9 @@ def parse_sweep(
             raise err("base", str(exc)) from None
     else:
         raise err("base", f"expected a scenario path or a table, got {describe_value(raw_base)}")
+    if base.excitation.seed_drawn:  # a new draw at every reading: the sweep could not be resumed or repeated
+        raise err("base", "excitation.seed: a random load in a sweep needs its seed in the scenario (one is drawn "
+                  f"otherwise, differently at every run); add excitation.seed = {base.excitation.seed}")
 
     # design
     design = data.get("design", "grid")
