@@ -26,9 +26,10 @@ duration ``T`` (:func:`~impactbeam.statistics.window.analysis_window`):
 The contact force is ``k max(-g, 0)`` with the opening ``g`` of
 :meth:`~impactbeam.model.beam.Contactor.gap_function`. ``F^2`` and
 ``|F v|`` are integrated by Gauss-Legendre quadrature on each side of the
-deepest compression (where ``|F v|`` has its kink), with panels of half a
-period of the highest retained frequency and 8 nodes each, so to round-off
-for the closed form between load breaks.
+deepest compression (where ``|F v|`` has its kink), with panels of one
+period of the highest retained frequency and 8 nodes each: exact for
+polynomials of degree 15, so within 1e-5 for a sinusoid at that frequency
+(``pi^16 / 16!``) and much closer for the lower modes that carry the force.
 """
 
 from __future__ import annotations
@@ -193,7 +194,7 @@ def impact_statistics(run: Any, window: tuple[float, float] | None = None) -> Im
     steady = hasattr(run, "result") and hasattr(run, "window")
     result = run.result if steady else run
     lo, hi = analysis_window(result, run.window if steady and window is None else window)
-    panel = math.pi / max(top_frequency(result), 1e-300)  # half a period of the highest mode
+    panel = 2.0 * math.pi / max(top_frequency(result), 1e-300)  # one period of the highest mode
     per, impacts = [], []
     for ci in range(len(result.contactors)):
         summary, rows = _contactor(result, ci, lo, hi, panel)
