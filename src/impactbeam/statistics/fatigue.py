@@ -7,9 +7,10 @@ exact solution is scanned at ``SAMPLES_PER_PERIOD`` samples per period of
 the highest retained frequency and at every event and load break (where the
 stress may have a kink), and each local extremum of the scan is refined on
 the closed form by golden-section search in its bracket of two scan steps
-(to 1e-6 of the bracket: near an extremum the stress departs from its peak
+(to 1e-5 of the bracket: near an extremum the stress departs from its peak
 quadratically, so the value carries a relative error of order
-``(omega_max dt)^2 ~ 1e-12``). The window's ends are kept as the first and last points, as the
+``(1e-5 omega_max dt)^2 ~ 1e-10``). The turning points of a result are kept
+with it (per point and window), so a figure after the damage costs nothing. The window's ends are kept as the first and last points, as the
 counting standard does.
 
 The turning points are counted by the rainflow method of ASTM E1049-85
@@ -48,7 +49,7 @@ __all__ = ["stress_turning_points", "rainflow_cycles", "cycles_to_failure", "min
 
 _CHUNK = 4096
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-_REFINE = 1e-6  # final bracket of the golden-section search over its initial two scan steps
+_REFINE = 1e-5  # final bracket of the golden-section search over its initial two scan steps
 
 
 def _stress(result: Any, x: float, t: np.ndarray) -> np.ndarray:
@@ -98,6 +99,16 @@ def stress_turning_points(result: ResultLike, x: float, lo: float, hi: float) ->
     values : ndarray, [Pa]
         Alternating maxima and minima, with the window's ends first and last.
     """
+    cache = result.__dict__.setdefault("_turning_points", {}) if hasattr(result, "__dict__") else {}
+    key = (float(x), float(lo), float(hi))
+    if key in cache:
+        return cache[key]
+    cache[key] = out = _turning_points(result, float(x), lo, hi)
+    return out
+
+
+def _turning_points(result: Any, x: float, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`stress_turning_points` without the cache."""
     t = scan_times(result, lo, hi)
     s = _stress(result, float(x), t)
     keep = np.concatenate([[True], np.diff(s) != 0.0])  # drop repeated values (a stress held constant)
