@@ -174,7 +174,7 @@ of flat density from 5 to 200 Hz; the seed makes the record repeatable."""),
     "damping": {"free": 0.02, "contact": 0.02},
     "excitation": {"kind": "distributed_force", "shape": "random",
                    "psd": [["5 Hz", "0.5 (N/m)^2/Hz"], ["200 Hz", "0.5 (N/m)^2/Hz"]], "seed": 11},
-    "solver": {"modes": 4, "end_time": 8.0},
+    "solver": {"modes": 4, "end_time": 6.0},
     "output": {"points": ["0.4 m", "0.2 m"]},
 })
 res = ib.simulate(tube)
@@ -194,7 +194,7 @@ intervals of confidence run several seeds (`ib.random_response`)."""),
         ("code", """gaps = [0.10e-3, 0.15e-3, 0.25e-3]
 rates = []
 for gap in gaps:
-    r = ib.simulate(tube.with_values({"contactors.0.gap": gap, "contactors.1.gap": gap, "solver.end_time": 4.0}))
+    r = ib.simulate(tube.with_values({"contactors.0.gap": gap, "contactors.1.gap": gap, "solver.end_time": 3.0}))
     rates.append(impact_statistics(r).contactors[0]["rate"])
 for gap, rate in zip(gaps, rates):
     print(f"gap {gap * 1e3:.2f} mm: {rate:6.1f} impacts/s")
@@ -214,7 +214,7 @@ cycles, m = 10) and Goodman's correction (S_u = 1800 MPa)."""),
     "damping": {"free": 0.02, "contact": 0.05},
     "excitation": {"kind": "distributed_force", "shape": "random",
                    "psd": [["20 Hz", "2 (N/m)^2/Hz"], ["1000 Hz", "2 (N/m)^2/Hz"]], "seed": 5},
-    "solver": {"modes": 3, "end_time": 3.0},
+    "solver": {"modes": 3, "end_time": 2.5},
     "fatigue": {"points": ["0 mm"], "sn_stress": "800 MPa", "sn_cycles": 1e6, "sn_exponent": 10,
                 "mean_stress": "goodman", "ultimate_strength": "1800 MPa"},
 })
