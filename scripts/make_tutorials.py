@@ -148,6 +148,107 @@ assert model == sorted(model)
 plot.plot_response([results[r["case"]] for r in rows], labels=[f"gap {r['gap']}" for r in rows],
                    time_window=(0.0, 0.08), title="Changing gap size (Fig. 6 analogue)")"""),
     ],
+    "random-vibration": [
+        ("md", """# Random vibration: a tube in a loose support, a reed valve's fatigue life
+
+Two questions industry asks of impacting beams, answered from random loads
+given by their one-sided power spectral density (see the
+[random vibration](../random-vibration.md) page for the conventions)."""),
+        ("code", SETUP + """
+from impactbeam.plot.random import plot_impact_histogram, plot_input_psd, plot_rainflow_histogram
+from impactbeam.statistics import (dirlik_damage_rate, fatigue_statistics, impact_statistics,
+                                   response_statistics, spectral_moments, welch_psd)"""),
+        ("md", """## A heat-exchanger tube span in a loose support
+
+A steel tube span (0.8 m between two baffles, pinned) passes a support
+plate at mid-span with 0.15 mm of clearance on each side: two contactors at
+one point, one above and one below. Flow turbulence is a distributed force
+of flat density from 5 to 200 Hz; the seed makes the record repeatable."""),
+        ("code", """tube = ib.parse_scenario({
+    "name": "tube span",
+    "beam": {"length": "0.8 m", "area": "67 mm^2", "second_moment": "2680 mm^4",
+             "youngs_modulus": "200 GPa", "density": "11000 kg/m^3"},  # steel, with the water inside
+    "supports": {"left": "pinned", "right": "pinned"},
+    "contactors": [{"position": "0.4 m", "stiffness": "2e5 N/m", "gap": "0.15 mm", "side": "below"},
+                   {"position": "0.4 m", "stiffness": "2e5 N/m", "gap": "0.15 mm", "side": "above"}],
+    "damping": {"free": 0.02, "contact": 0.02},
+    "excitation": {"kind": "distributed_force", "shape": "random",
+                   "psd": [["5 Hz", "0.5 (N/m)^2/Hz"], ["200 Hz", "0.5 (N/m)^2/Hz"]], "seed": 11},
+    "solver": {"modes": 4, "end_time": 6.0},
+    "output": {"points": ["0.4 m", "0.2 m"]},
+})
+res = ib.simulate(tube)
+stats = impact_statistics(res)
+print(f"statistics over {stats.window[0]:.2f}-{stats.window[1]:.0f} s (the start from rest is left out)")
+for c in stats.contactors:
+    print(f"contactor {c['contactor']}: {c['rate']:.1f} impacts/s, force RMS {c['force_rms']:.2f} N, "
+          f"contact {100 * c['contact_fraction']:.1f} % of the time, mean peak {c['peak_force_mean']:.1f} N")
+assert all(c["rate"] > 10 for c in stats.contactors)  # the tube rattles on both faces"""),
+        ("md", """The load the solver integrated against its target, with the band in which a
+Gaussian estimate falls 95 % of the time, and the peak forces of the impacts:"""),
+        ("code", """plot_input_psd(tube.excitation)"""),
+        ("code", """plot_impact_histogram(stats)"""),
+        ("md", """The curve of tube-support design: impact rate against clearance. Each gap
+uses the same random record (the same seed), so the curve is smooth; for
+intervals of confidence run several seeds (`ib.random_response`)."""),
+        ("code", """gaps = [0.10e-3, 0.15e-3, 0.25e-3]
+rates = []
+for gap in gaps:
+    r = ib.simulate(tube.with_values({"contactors.0.gap": gap, "contactors.1.gap": gap, "solver.end_time": 3.0}))
+    rates.append(impact_statistics(r).contactors[0]["rate"])
+for gap, rate in zip(gaps, rates):
+    print(f"gap {gap * 1e3:.2f} mm: {rate:6.1f} impacts/s")
+assert rates[0] > rates[1] > rates[2]"""),
+        ("md", """## A reed valve's fatigue life
+
+A spring-steel reed (30 x 10 x 0.3 mm) rests on its seat (zero gap at the
+tip) and is loaded by pressure pulsations, a distributed force of flat
+density from 20 to 1000 Hz. At the clamped root the outer-fibre bending
+stress is counted by rainflow, with Basquin's curve (800 MPa at 10^6
+cycles, m = 10) and Goodman's correction (S_u = 1800 MPa)."""),
+        ("code", """reed = ib.parse_scenario({
+    "name": "reed valve",
+    "beam": {"length": "30 mm", "width": "10 mm", "height": "0.3 mm",
+             "youngs_modulus": "200 GPa", "density": "7850 kg/m^3"},
+    "contactors": [{"position": "30 mm", "stiffness": "2e4 N/m", "gap": "0 mm", "side": "below"}],
+    "damping": {"free": 0.02, "contact": 0.05},
+    "excitation": {"kind": "distributed_force", "shape": "random",
+                   "psd": [["20 Hz", "2 (N/m)^2/Hz"], ["1000 Hz", "2 (N/m)^2/Hz"]], "seed": 5},
+    "solver": {"modes": 3, "end_time": 2.5},
+    "fatigue": {"points": ["0 mm"], "sn_stress": "800 MPa", "sn_cycles": 1e6, "sn_exponent": 10,
+                "mean_stress": "goodman", "ultimate_strength": "1800 MPa"},
+})
+valve = ib.simulate(reed)
+root = fatigue_statistics(valve)[0]
+print(f"{root['cycles']:.0f} cycles in {root['duration']:.2f} s, largest range {root['max_range'] / 1e6:.0f} MPa")
+print(f"damage rate {root['damage_rate']:.3g} 1/s: life {root['life'] / 3600:.3g} h")
+assert 0 < root["life"] < np.inf"""),
+        ("code", """plot_rainflow_histogram(valve)"""),
+        ("md", """### Cross-check without the seat: Dirlik's spectral estimate
+
+Without contact the stress is a linear, stationary Gaussian process and
+Dirlik's formula predicts the rainflow damage from four moments of its
+density. The density here is Welch's estimate of the exact stress history
+of an 8 s record, and the comparison uses m = 4: with m = 10 the counted
+damage of one short record hangs on a handful of its largest cycles
+(average several seeds first)."""),
+        ("code", """free_reed = ib.parse_scenario({
+    **{k: v for k, v in reed.data.items() if k not in ("contactors", "fatigue", "solver")},
+    "solver": {"modes": 3, "end_time": 8.0},
+    "fatigue": {"points": [0.0], "sn_stress": "800 MPa", "sn_cycles": 1e6, "sn_exponent": 4},
+})
+lin = ib.simulate(free_reed)
+counted = fatigue_statistics(lin)[0]["damage_rate"]
+lo, hi = ib.statistics.analysis_window(lin)
+rate = 20000.0  # Hz: four samples per period of the highest retained mode (4.8 kHz)
+t = np.arange(lo, hi, 1 / rate)
+stress = np.concatenate([lin.bending_stress([0.0], t[i:i + 4096])[0] for i in range(0, t.size, 4096)])
+est = welch_psd(stress, rate, segment=int(rate))
+dirlik = dirlik_damage_rate(spectral_moments(est["frequency"], est["psd"]), 800e6, 1e6, 4)
+print(f"damage rate: rainflow of the exact stress {counted:.3g} 1/s, Dirlik {dirlik:.3g} 1/s "
+      f"(ratio {dirlik / counted:.3f})")
+assert 0.9 < dirlik / counted < 1.1  # measured 1.00-1.02 over three seeds of 8 s"""),
+    ],
 }
 
 

@@ -3,7 +3,9 @@
 The notebooks are executed with nbclient in a fresh kernel that imports this
 tree's package; their cells assert what they claim (e.g. the fitted contact
 stiffness within 5 % of the synthetic records' hidden truth). Together they
-must stay under 60 s. The full Sphinx build (``make docs``; warnings are
+must stay under 75 s: 60 s for the first four, and 15 s more for the fifth
+(random vibration), whose fresh kernel alone (imports, the compiled kernels
+loaded from numba's cache) costs about 10 s of its 20 s on this 2-core machine. The full Sphinx build (``make docs``; warnings are
 errors) is the ``docs`` marked test.
 """
 
@@ -29,9 +31,9 @@ def _kernel_env() -> None:
     os.environ.setdefault("MPLBACKEND", "Agg")
 
 
-def test_there_are_four_tutorials() -> None:
+def test_there_are_five_tutorials() -> None:
     names = {p.stem for p in NOTEBOOKS}
-    assert names == {"first-simulation", "parameter-study", "identification", "paper-reproduction"}
+    assert names == {"first-simulation", "parameter-study", "identification", "paper-reproduction", "random-vibration"}
 
 
 def test_notebooks_are_generated_from_the_script_and_stored_without_outputs() -> None:
@@ -74,7 +76,7 @@ def test_tutorials_are_fast_enough() -> None:
         pytest.skip("the notebooks did not all run in this session")
     total = sum(_TIMES.values())
     print(f"\ntutorials: {', '.join(f'{k} {v:.1f} s' for k, v in _TIMES.items())}; total {total:.1f} s")
-    assert total < 60.0
+    assert total < 75.0
 
 
 def test_scenario_reference_covers_the_schema() -> None:

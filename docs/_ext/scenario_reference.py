@@ -47,7 +47,7 @@ MEANING: dict[str, str] = {
     "damping.alpha": "Rayleigh mass coefficient alpha [1/s]: C = alpha M + beta K (`rayleigh`).",
     "damping.beta": "Rayleigh stiffness coefficient beta [s] (`rayleigh`).",
     "excitation.kind": "What the load is.",
-    "excitation.shape": "Time history: half-sine pulse, step, harmonic, or a table from `file`.",
+    "excitation.shape": "Time history: half-sine pulse, step, harmonic, a table from `file`, or random (from `psd`).",
     "excitation.amplitude": "Peak value: [m/s^2] (or g) for base acceleration, [N] point force, [N/m] distributed.",
     "excitation.duration": "Pulse length [s] (half_sine).",
     "excitation.frequency": "Forcing frequency f [Hz] (harmonic): amplitude sin(2 pi f (t - start) + phase) for t >= start.",
@@ -58,6 +58,23 @@ MEANING: dict[str, str] = {
     "excitation.scale": "Factor on the whole history (fits and sweeps of the load level).",
     "excitation.file": "CSV or text table of time and value (shape = table), relative to the scenario file.",
     "excitation.hold": "How a table is held between samples.",
+    "excitation.psd": "Random load (shape = random): one-sided power spectral density as [[frequency, level], ...], "
+                      "log-log between the points, zero outside; levels in the square of the load's unit per Hz "
+                      "(`\"0.01 g^2/Hz\"`, N^2/Hz, (N/m)^2/Hz). See the random vibration page.",
+    "excitation.seed": "Random load: the integer seed of its stream (numpy SeedSequence); drawn, reported and kept "
+                       "when absent.",
+    "excitation.stream": "Random load: member of an ensemble, the stream SeedSequence(seed).spawn(n)[stream] "
+                         "(set by `impactbeam random`).",
+    "excitation.sample_rate": "Random load: samples per second of the held history [Hz]; default 8 times the "
+                              "density's highest frequency.",
+    "fatigue.points": "Positions [m] where the bending stress is counted for fatigue (list).",
+    "fatigue.sn_stress": "Basquin S-N curve N(S) = sn_cycles (S / sn_stress)^-sn_exponent: the stress amplitude "
+                         "S_ref [Pa] of its reference point.",
+    "fatigue.sn_cycles": "Cycles to failure N_ref at `sn_stress`.",
+    "fatigue.sn_exponent": "Basquin exponent m (> 0).",
+    "fatigue.endurance_limit": "Amplitudes at or below it do no damage [Pa] (default 0: none).",
+    "fatigue.mean_stress": "Mean-stress correction of each cycle's amplitude.",
+    "fatigue.ultimate_strength": "S_u [Pa] of Goodman's line (with mean_stress = goodman).",
     "initial.tip_displacement": "Static tip deflection to release from [m] (paper Case 0).",
     "initial.position": "Where the initial static deflection is imposed [m] (default the tip).",
     "initial.modal_displacement": "Initial modal coordinates eta_n(0) of the free state (list).",
@@ -108,6 +125,7 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "contactors[].side": S._SIDES,
     "damping.model": DAMPING_MODELS,
     "output.fields": S.OUTPUT_FIELDS,
+    "fatigue.mean_stress": S._MEAN_STRESS,
     "supports.left": tuple(SUPPORT_PRESETS),
     "supports.right": tuple(SUPPORT_PRESETS),
 }

@@ -74,8 +74,12 @@ _EXPORTS: dict[str, str] = {
     "FrequencyResponse": "periodic.frf",
     "frequency_response": "periodic.frf",
     "linear_frf": "periodic.frf",
-    "ImpactStatistics": "periodic.impact_stats",
-    "impact_statistics": "periodic.impact_stats",
+    "ImpactStatistics": "statistics",
+    "impact_statistics": "statistics",
+    "PowerSpectralDensity": "model.psd",
+    "FatigueSpec": "model.fatigue",
+    "random_response": "random",
+    "RandomResponse": "random",
 }
 
 __all__ = [*_EXPORTS, "__version__"]
@@ -112,7 +116,10 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .periodic.bifurcation import BifurcationDiagram, bifurcation
     from .periodic.frf import FrequencyResponse, frequency_response, linear_frf
     from .periodic.maps import bifurcation_map
-    from .periodic.impact_stats import ImpactStatistics, impact_statistics
+    from .statistics import ImpactStatistics, impact_statistics
+    from .model.psd import PowerSpectralDensity
+    from .model.fatigue import FatigueSpec
+    from .random import RandomResponse, random_response
     from .periodic.strobe import SteadyState, steady_state
     from .solver import ModalState
     from .sweeps import sweep

@@ -5,7 +5,8 @@ unit that :mod:`pint` understands (``"0.229 mm"``, ``"15 ms"``, ``"1834 MPa"``,
 ``"4030 N/m"``). Two conventions go beyond pint:
 
 * for accelerations, ``g`` means standard gravity, 9.80665 m/s^2
-  (``"15 g"``, ``"0.5 g"``); pint's own ``g`` is the gram;
+  (``"15 g"``, ``"0.5 g"``), also in acceleration spectral densities
+  (``"0.01 g^2/Hz"``); pint's own ``g`` is the gram;
 * ``"inf"`` (or ``"infinity"``) is accepted for stiffnesses only, meaning rigid.
 
 NaN is rejected everywhere. Every error is a :class:`~impactbeam.exceptions.ScenarioError`
@@ -69,10 +70,17 @@ DIMENSIONS: dict[str, _Dimension] = {
     "rotary_inertia": _Dimension("kg m^2", "kg*m^2", "a rotary inertia"),
     "damping_coefficient": _Dimension("N s/m", "N*s/m", "a damping coefficient"),
     "rate": _Dimension("1/s", "1/s", "a rate (per second)"),
+    "stress": _Dimension("Pa", "Pa", "a stress"),
+    # one-sided power spectral densities (random loads): the square of the load's unit per hertz
+    "acceleration_psd": _Dimension("(m/s^2)^2/Hz", "m**2/s**4/Hz", "an acceleration spectral density"),
+    "force_psd": _Dimension("N^2/Hz", "N**2/Hz", "a force spectral density"),
+    "force_per_length_psd": _Dimension("(N/m)^2/Hz", "N**2/m**2/Hz", "a spectral density of force per length"),
     "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
 }
 
 _STIFFNESSES = {"stiffness", "rotational_stiffness"}
+#: Dimensions in which ``g`` is standard gravity (``"15 g"``, ``"0.01 g^2/Hz"``).
+_GRAVITY_DIMENSIONS = {"acceleration", "acceleration_psd"}
 
 # Names for the dimensionality of a string that did not match, for the message.
 _KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
@@ -85,6 +93,8 @@ _KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
     ("m/s", "a velocity"),
     ("N*s/m", "a damping coefficient"),
     ("m/s^2", "an acceleration"),
+    ("m^2/s^3", "an acceleration spectral density ((m/s^2)^2/Hz)"),
+    ("N^2/Hz", "a force spectral density"),
     ("N", "a force"),
     ("N/m", "a stiffness or force per length"),
     ("Pa", "a pressure or modulus"),
@@ -198,7 +208,7 @@ def _parse(text: str, dimension: str, shown: str | None = None) -> Any:
     """
     ureg = registry()
     expr = text
-    if dimension == "acceleration":
+    if dimension in _GRAVITY_DIMENSIONS:
         expr = _GRAVITY_G.sub("g_0", expr)
     try:
         quantity = ureg.parse_expression(expr)
@@ -227,6 +237,10 @@ COMMON_UNITS: dict[tuple[str, str], float] = {
     **{(u, "area"): f for u, f in (("m^2", 1.0), ("mm^2", 1e-6))},
     **{(u, "second_moment"): f for u, f in (("m^4", 1.0),)},
     ("N*m/rad", "rotational_stiffness"): 1.0,
+    **{(u, "stress"): f for u, f in (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9))},
+    **{(u, "acceleration_psd"): f for u, f in (("g^2/Hz", STANDARD_GRAVITY**2), ("(m/s^2)^2/Hz", 1.0))},
+    ("N^2/Hz", "force_psd"): 1.0,
+    **{(u, "frequency"): f for u, f in (("Hz", 1.0), ("kHz", 1e3))},
 }
 _FACTORS: dict[tuple[str, str], float] = {}
 
@@ -312,7 +326,9 @@ def to_si(value: Any, dimension: str, key: str) -> float:
         One of :data:`DIMENSIONS`: ``"length"``, ``"stiffness"`` (N/m),
         ``"rotational_stiffness"`` (N m/rad), ``"modulus"`` (Pa), ``"density"``
         (kg/m^3), ``"area"``, ``"second_moment"``, ``"time"``, ``"acceleration"``,
-        ``"force"``, ``"force_per_length"``, ``"dimensionless"``.
+        ``"force"``, ``"force_per_length"``, ``"stress"`` (Pa), the one-sided
+        spectral densities ``"acceleration_psd"`` ((m/s^2)^2/Hz, ``"0.01 g^2/Hz"``),
+        ``"force_psd"`` (N^2/Hz), ``"force_per_length_psd"`` ((N/m)^2/Hz), ``"dimensionless"``.
     key : str
         Dotted name of the field, used in error messages.
 

@@ -22,6 +22,7 @@ from . import (
     cmd_measure,
     cmd_modes,
     cmd_periodic,
+    cmd_random,
     cmd_reproduce,
     cmd_simulate,
     cmd_sweep,
@@ -42,6 +43,7 @@ for _command in (
     cmd_bifurcation.bifurcation_command,
     cmd_bifurcation.bifurcation_map_command,
     cmd_periodic.periodic,
+    cmd_random.random_command,
     cmd_explore.explore,
     cmd_info.info,
 ):

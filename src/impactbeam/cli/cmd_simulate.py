@@ -95,6 +95,11 @@ def simulate(
     metrics = result.metrics()
     metrics["modes"] = result.n_modes
     metrics["convergence"] = result.convergence  # computed now, so its warning is caught below
+    from ..statistics import run_statistics
+
+    metrics.update(run_statistics(result))  # impact statistics per contactor and, with [fatigue], fatigue
+    if sc.excitation.shape == "random":
+        metrics["seed"] = sc.excitation.seed  # drawn when the scenario gives none: reported to repeat the run
     if out is not None:
         try:
             write_result(result, out)
@@ -175,4 +180,8 @@ def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
         key = max(conv, key=lambda k: conv[k])
         lines.append(f"  modes: {metrics.get('modes')}; largest relative change against fewer modes: "
                      f"{conv[key]:.2g} ({key})")
+    from ._statistics import statistics_lines
+
+    lines += statistics_lines(metrics.get("impact_statistics") or [], metrics.get("fatigue") or [],
+                              metrics.get("statistics_window"))
     return "\n".join(lines)

@@ -9,7 +9,10 @@ time history ``u(t)``. Base acceleration ``ug''(t)`` is the distributed load
 * ``step``: ``A`` for ``t >= start``;
 * ``harmonic``: ``A sin(2 pi f (t - start) + phase)`` for ``t >= start``;
 * ``table``: samples ``(t_k, u_k)`` held constant (the paper's rectangular steps)
-  or linear between samples (first-order hold), shifted by ``start``; zero outside.
+  or linear between samples (first-order hold), shifted by ``start``; zero outside;
+* ``random``: a stationary Gaussian history of one-sided power spectral
+  density ``psd`` (:mod:`impactbeam.model.psd`), synthesised from ``seed``
+  over ``duration`` and held linearly between its samples, from ``start``.
 
 Every shape is integrated in closed form by the solver: the half-sine and the
 harmonic load exactly (also at an undamped resonance), the table exactly for
@@ -25,12 +28,14 @@ from typing import Literal
 import numpy as np
 
 from .._validation import choice, finite, nonnegative_finite, positive_finite
+from .._warnings import emit_user_level_warning
 from ..exceptions import ParameterError
+from .psd import MIN_LINES, PowerSpectralDensity, synthesize
 
 __all__ = ["Excitation", "InitialCondition", "ExcitationKind", "ExcitationShape", "Hold"]
 
 ExcitationKind = Literal["base_acceleration", "point_force", "distributed_force", "none"]
-ExcitationShape = Literal["half_sine", "step", "table", "harmonic"]
+ExcitationShape = Literal["half_sine", "step", "table", "harmonic", "random"]
 Hold = Literal["constant", "linear"]
 
 UNITS = {"base_acceleration": "m/s^2", "point_force": "N", "distributed_force": "N/m", "none": ""}
@@ -43,13 +48,13 @@ class Excitation:
     Parameters
     ----------
     kind : {"base_acceleration", "point_force", "distributed_force", "none"}
-    shape : {"half_sine", "step", "table", "harmonic"}
+    shape : {"half_sine", "step", "table", "harmonic", "random"}
     amplitude : float
         Peak value: [m/s^2] for base acceleration, [N] point force, [N/m]
         distributed force. Positive along +w. For ``table`` the tabulated
-        values are used as given and ``amplitude`` is ignored.
+        values are used as given and ``amplitude`` is ignored (also for ``random``).
     duration : float or None, [s]
-        Pulse length (half_sine only).
+        Pulse length (half_sine); length of the random history (random).
     start : float, [s]
         When the pulse, step, table or harmonic load begins.
     position : float or None, [m]
@@ -65,6 +70,22 @@ class Excitation:
         Forcing frequency ``f`` (harmonic only).
     phase : float, [rad]
         Phase of the harmonic load at ``start`` (harmonic only).
+    psd : PowerSpectralDensity or None
+        One-sided density of the random load (random only).
+    seed : int or None
+        Root of the random stream (random only; ``numpy.random.SeedSequence(seed)``).
+    stream : int or None
+        Member of an ensemble: the stream ``SeedSequence(seed).spawn(n)[stream]`` (random only).
+    sample_rate : float or None, [Hz]
+        Load samples per second (random only); default
+        :data:`~impactbeam.model.psd.RATE_FACTOR` times the density's highest frequency.
+    seed_drawn : bool
+        The seed was drawn because the scenario gave none (reported, so the run can be repeated).
+
+    Notes
+    -----
+    A random load is synthesised when the object is made: ``times`` and
+    ``values`` then hold its samples (relative to ``start``), held linearly.
     """
 
     kind: ExcitationKind = "none"
@@ -79,10 +100,15 @@ class Excitation:
     scale: float = 1.0
     frequency: float | None = None
     phase: float = 0.0
+    psd: PowerSpectralDensity | None = field(default=None, repr=False)
+    seed: int | None = None
+    stream: int | None = None
+    sample_rate: float | None = None
+    seed_drawn: bool = False
 
     def __post_init__(self) -> None:
         choice("excitation.kind", self.kind, tuple(UNITS))
-        choice("excitation.shape", self.shape, ("half_sine", "step", "table", "harmonic"))
+        choice("excitation.shape", self.shape, ("half_sine", "step", "table", "harmonic", "random"))
         choice("excitation.hold", self.hold, ("constant", "linear"))
         object.__setattr__(self, "amplitude", finite("excitation.amplitude", self.amplitude))
         object.__setattr__(self, "start", nonnegative_finite("excitation.start", self.start))
@@ -102,6 +128,8 @@ class Excitation:
             if self.position is None:
                 raise ParameterError("excitation.position: required for a point_force")
             object.__setattr__(self, "position", nonnegative_finite("excitation.position", self.position))
+        if self.shape == "random":
+            self._synthesize()
         if self.shape == "table":
             if self.times is None or self.values is None:
                 raise ParameterError("excitation.file: a table excitation needs times and values")
@@ -117,6 +145,33 @@ class Excitation:
             v.setflags(write=False)
             object.__setattr__(self, "times", t)
             object.__setattr__(self, "values", v)
+
+    def _synthesize(self) -> None:
+        """Draw the samples of a random load (:func:`impactbeam.model.psd.synthesize`)."""
+        if not isinstance(self.psd, PowerSpectralDensity):
+            raise ParameterError("excitation.psd: required for a random load (a PowerSpectralDensity)")
+        for name in ("seed", "stream"):
+            value = getattr(self, name)
+            if value is None and name == "stream":
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise ParameterError(f"excitation.{name}: expected an integer >= 0, got {value!r}")
+        if self.duration is None:
+            raise ParameterError("excitation.duration: required for a random load (the length of the history)")
+        duration = positive_finite("excitation.duration", self.duration)
+        times, values, lines = synthesize(self.psd, duration, int(self.seed), self.stream,  # type: ignore[arg-type]
+                                          self.sample_rate)
+        if lines < MIN_LINES:
+            lo, hi = self.psd.band
+            emit_user_level_warning(
+                f"excitation.psd: a history of {duration:g} s has only {lines} spectral lines (spacing "
+                f"{1 / duration:g} Hz) in the band {lo:g}-{hi:g} Hz; the load is far from Gaussian and its "
+                f"spectrum coarse: simulate at least {MIN_LINES / (hi - lo):.3g} s"
+            )
+        object.__setattr__(self, "duration", duration)
+        object.__setattr__(self, "times", times)
+        object.__setattr__(self, "values", values)
+        object.__setattr__(self, "hold", "linear")
 
     @property
     def unit(self) -> str:
@@ -137,7 +192,7 @@ class Excitation:
             return self.start + self.duration
         if self.shape in ("step", "harmonic"):
             return math.inf
-        assert self.times is not None
+        assert self.times is not None  # table and random
         return self.start + float(self.times[-1])
 
     def history(self, t: np.ndarray) -> np.ndarray:
@@ -236,17 +291,28 @@ class TimePiece:
         return self.const + self.slope * tau + self.amp * math.sin(self.Omega * tau + self.phase)
 
 
-def time_pieces(excitation: Excitation, end_time: float) -> list[TimePiece]:
-    """Cut the history of ``excitation`` on [0, end_time] into pieces of one closed form each.
+#: The fields of a time piece, in the order of the arrays of :func:`piece_arrays`.
+PIECE_FIELDS = ("t0", "t1", "const", "slope", "amp", "Omega", "phase")
 
-    The solver integrates each piece exactly: the half-sine and the harmonic
-    load as a sinusoid, a table held constant (paper, rectangular steps before eq. 10) or linear
-    (first-order hold) between samples.
+
+def piece_arrays(excitation: Excitation, end_time: float) -> tuple[np.ndarray, ...]:
+    """The pieces of :func:`time_pieces` as seven arrays (``PIECE_FIELDS``), built without a Python loop.
+
+    Parameters
+    ----------
+    excitation : Excitation
+    end_time : float, [s]
+        End of the run.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``t0, t1, const, slope, amp, Omega, phase``, one entry per piece.
     """
     T = float(end_time)
     s = excitation.scale
     if not excitation.active:
-        return [TimePiece(0.0, T)]
+        return tuple(np.array([v]) for v in (0.0, T, 0.0, 0.0, 0.0, 0.0, 0.0))
     start = excitation.start
     raw: list[TimePiece] = []
     if excitation.shape == "half_sine":
@@ -265,29 +331,40 @@ def time_pieces(excitation: Excitation, end_time: float) -> list[TimePiece]:
         raw.append(
             TimePiece(start, math.inf, amp=s * excitation.amplitude, Omega=Om, phase=excitation.phase)
         )
-    else:
+    if raw:
+        cols = [np.array([getattr(p, f) for p in raw], dtype=float) for f in PIECE_FIELDS]
+    else:  # a table or a random load: samples held constant or linear
         assert excitation.times is not None and excitation.values is not None
         tk = excitation.times + start
         vk = s * excitation.values
-        raw.append(TimePiece(0.0, float(tk[0])))
-        for i in range(tk.size - 1):
-            t0, t1 = float(tk[i]), float(tk[i + 1])
-            if excitation.hold == "linear":
-                slope = (vk[i + 1] - vk[i]) / (t1 - t0)
-                raw.append(TimePiece(t0, t1, const=float(vk[i]), slope=float(slope)))
-            else:
-                raw.append(TimePiece(t0, t1, const=float(vk[i])))
-        raw.append(TimePiece(float(tk[-1]), math.inf))
-    out = []
-    for p in raw:
-        t0, t1 = max(p.t0, 0.0), min(p.t1, T)
-        if t1 <= t0:
-            continue
-        if t0 > p.t0:  # shift the piece's origin to t0
-            tau = t0 - p.t0
-            p = TimePiece(p.t0, p.t1, p.const + p.slope * tau, p.slope, p.amp, p.Omega, p.phase + p.Omega * tau)
-        out.append(TimePiece(t0, t1, p.const, p.slope, p.amp, p.Omega, p.phase))
-    return out
+        m = tk.size - 1
+        slope = (vk[1:] - vk[:-1]) / (tk[1:] - tk[:-1]) if excitation.hold == "linear" else np.zeros(m)
+        zero = np.zeros(m + 2)
+        cols = [
+            np.concatenate([[0.0], tk[:-1], [tk[-1]]]), np.concatenate([[tk[0]], tk[1:], [math.inf]]),
+            np.concatenate([[0.0], vk[:-1], [0.0]]), np.concatenate([[0.0], slope, [0.0]]),
+            zero, zero.copy(), zero.copy(),
+        ]
+    p_t0, p_t1, const, slope_, amp, Omega, phase = cols
+    t0, t1 = np.maximum(p_t0, 0.0), np.minimum(p_t1, T)
+    keep = t1 > t0
+    shifted = t0 > p_t0  # shift the piece's origin to t0
+    tau = np.where(shifted, t0 - p_t0, 0.0)
+    const = np.where(shifted, const + slope_ * tau, const)
+    phase = np.where(shifted, phase + Omega * tau, phase)
+    return tuple(np.ascontiguousarray(a[keep]) for a in (t0, t1, const, slope_, amp, Omega, phase))
+
+
+def time_pieces(excitation: Excitation, end_time: float) -> list[TimePiece]:
+    """Cut the history of ``excitation`` on [0, end_time] into pieces of one closed form each.
+
+    The solver integrates each piece exactly: the half-sine and the harmonic
+    load as a sinusoid, a table held constant (paper, rectangular steps before eq. 10) or linear
+    (first-order hold) between samples, a random load linear between its samples.
+    The same pieces as arrays: :func:`piece_arrays`.
+    """
+    cols = piece_arrays(excitation, end_time)
+    return [TimePiece(*row) for row in zip(*(c.tolist() for c in cols))]
 
 
 def spatial_projection(

@@ -72,10 +72,11 @@ def _excitation_static(beam: Any, excitation: Any, x: np.ndarray) -> np.ndarray:
 def _free_coordinates(sol: Any, eta: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The solution's coordinates at ``t`` carried into the free state's basis: (n_t, n)."""
     space = sol.packed.space
-    keys = [sol.engaged(int(j)) for j in sol.segment_index(t)]
+    slots = np.asarray(sol.slot)[sol.segment_index(t)] if sol.n_segments else np.zeros(t.size, dtype=np.int64)
     out = np.empty_like(eta)
-    for key in set(keys):
-        rows = np.array([k == key for k in keys])
+    for slot in np.unique(slots):  # one change of basis per visited state, not per time
+        rows = slots == slot
+        key = sol.packed.keys[int(slot)]
         T = space.transfer((), key, sol.packed.preserve) if key else None
         out[rows] = eta[rows] if T is None else eta[rows] @ T.T
     return out

@@ -14,6 +14,7 @@ from .._warnings import emit_user_level_warning
 from ..model.beam import Beam, Contactor
 from ..exceptions import ScenarioError
 from ..model.loading import Excitation, InitialCondition
+from ..model.fatigue import FatigueSpec
 from ..model import Damping, SolverOptions
 from .edit import _normalise, scenario_toml, set_path
 from .checks import check_magnitudes, warn_numeric_strings
@@ -21,6 +22,7 @@ from .fields import _string
 from .parse_run import (
     _parse_damping,
     _parse_excitation,
+    _parse_fatigue,
     _parse_initial,
     _parse_output,
     _parse_output_fields,
@@ -60,6 +62,8 @@ class Scenario:
         Fields of result files (``[output] fields``, canonical names):
         ``displacement`` and ``velocity`` (always written), ``moment`` and
         ``stress`` (which also adds its maximum to the metrics).
+    fatigue : FatigueSpec or None
+        ``[fatigue]``: the points and S-N curve of the fatigue statistics.
     """
 
     beam: Beam
@@ -74,6 +78,7 @@ class Scenario:
     base_dir: Path | None = None
     name: str = "scenario"
     output_fields: tuple[str, ...] = ()
+    fatigue: FatigueSpec | None = None
 
     def to_toml(self) -> str:
         """The scenario as TOML text (``load_scenario`` of it gives the same scenario)."""
@@ -175,6 +180,7 @@ def parse_scenario(
         base_dir=base,
         name=name,
         output_fields=_parse_output_fields(raw),
+        fatigue=_parse_fatigue(raw, beam),
     )
     warn_unusual(scenario)
     return scenario

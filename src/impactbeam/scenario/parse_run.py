@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -9,6 +10,8 @@ from typing import Any
 from ..model.beam import Beam, Contactor
 from ..exceptions import ScenarioError
 from ..model.loading import Excitation, InitialCondition
+from ..model.fatigue import FatigueSpec
+from ..model.psd import PowerSpectralDensity
 from ..model import BASES, Damping, SolverOptions
 from ..model.damping import DAMPING_MODELS, MODEL_KEYS
 from ..units import describe_dimension, to_si
@@ -25,7 +28,17 @@ from .fields import (
     _required,
     _string,
 )
-from .schema import OUTPUT_FIELD_ALIASES, OUTPUT_FIELDS, EXCITATION_DIMENSIONS, _HOLDS, _KINDS, _SHAPES, _join
+from .schema import (
+    EXCITATION_DIMENSIONS,
+    OUTPUT_FIELD_ALIASES,
+    OUTPUT_FIELDS,
+    PSD_DIMENSIONS,
+    _HOLDS,
+    _KINDS,
+    _MEAN_STRESS,
+    _SHAPES,
+    _join,
+)
 from .traces import read_table
 
 __all__ = []
@@ -80,7 +93,15 @@ def _parse_excitation(raw: Mapping[str, Any], beam: Beam, base_dir: Path | None)
     amplitude = 0.0
     times = values = None
     hold = "constant"
-    if shape == "table":
+    random: dict[str, Any] = {}
+    if shape == "random":
+        random = _parse_random(raw, ex, kind, start)
+    else:
+        _reject_unused(ex, ("psd", "seed", "stream", "sample_rate"), f'with shape = "{shape}" (only with shape = "random")')
+    if shape == "random":
+        _reject_unused(ex, ("amplitude", "file", "hold"), 'with shape = "random" (the psd sets the level; '
+                       "excitation.scale multiplies the history, so the density by its square)")
+    elif shape == "table":
         if "amplitude" in ex:
             raise ScenarioError(
                 'excitation.amplitude: has no effect with shape = "table" (the file holds the '
@@ -99,10 +120,13 @@ def _parse_excitation(raw: Mapping[str, Any], beam: Beam, base_dir: Path | None)
         _required(ex, "excitation", "amplitude", f' for kind = "{kind}" ({describe_dimension(dimension)})')
         amplitude = to_si(ex["amplitude"], dimension, "excitation.amplitude")
 
-    duration = None
+    duration = random.pop("duration", None)
     if shape == "half_sine":
         _required(ex, "excitation", "duration", " for a half_sine pulse")
         duration = _positive(ex, "excitation", "duration", "time")
+    elif shape == "random":
+        _reject_unused(ex, ("duration",), 'with shape = "random" (the history lasts from excitation.start to '
+                       "solver.end_time)")
     else:
         _reject_unused(ex, ("duration",), f'with shape = "{shape}" (only with shape = "half_sine")')
 
@@ -134,7 +158,79 @@ def _parse_excitation(raw: Mapping[str, Any], beam: Beam, base_dir: Path | None)
             scale=scale,
             frequency=frequency,
             phase=phase,
+            **random,
         )
+
+
+def _parse_random(raw: Mapping[str, Any], ex: Mapping[str, Any], kind: str, start: float) -> dict[str, Any]:
+    """The fields of a random excitation: ``psd``, ``seed`` (drawn when absent), ``stream``, ``sample_rate``.
+
+    A drawn seed is written into ``raw`` (the scenario's private copy), so the
+    scenario's data, its TOML and every run made from it repeat the same history.
+    """
+    _required(ex, "excitation", "psd", ' for shape = "random" ([[frequency, level], ...], one-sided)')
+    rows = ex["psd"]
+    dims = ("frequency", PSD_DIMENSIONS[kind])
+    freqs, levels = [], []
+    for i, row in enumerate(rows):
+        freqs.append(to_si(row[0], dims[0], f"excitation.psd.{i}.0"))
+        levels.append(to_si(row[1], dims[1], f"excitation.psd.{i}.1"))
+    with _relabel("excitation.psd"):
+        psd = PowerSpectralDensity(freqs, levels)
+    out: dict[str, Any] = {"psd": psd, "seed_drawn": "seed" not in ex}
+    if "seed" in ex:
+        out["seed"] = _integer("excitation.seed", ex["seed"])
+    else:
+        import secrets
+
+        out["seed"] = secrets.randbits(32)
+        raw["excitation"]["seed"] = out["seed"]  # type: ignore[index]
+    if "stream" in ex:
+        out["stream"] = _integer("excitation.stream", ex["stream"])
+    for name in ("seed", "stream"):
+        if out.get(name) is not None and out[name] < 0:
+            raise ScenarioError(f"excitation.{name}: must be an integer >= 0, got {out[name]}", key=f"excitation.{name}")
+    if "sample_rate" in ex:
+        out["sample_rate"] = _positive(ex, "excitation", "sample_rate", "frequency")
+    end = _parse_solver(raw).end_time
+    if start >= end:
+        raise ScenarioError(
+            f"excitation.start: the random load starts at {start:g} s, at or after solver.end_time = {end:g} s",
+            key="excitation.start",
+        )
+    out["duration"] = end - start
+    return out
+
+
+def _parse_fatigue(raw: Mapping[str, Any], beam: Beam) -> FatigueSpec | None:
+    """``[fatigue]``: the points and the S-N curve (Basquin), or None when absent."""
+    fat = raw.get("fatigue")
+    if fat is None:
+        return None
+    _required(fat, "fatigue", "points", " (x positions where the damage is computed)")
+    if not fat["points"]:
+        raise ScenarioError("fatigue.points: the list is empty", key="fatigue.points")
+    points = tuple(_on_beam(f"fatigue.points.{i}", to_si(v, "length", f"fatigue.points.{i}"), beam.length)
+                   for i, v in enumerate(fat["points"]))
+    for i, x in enumerate(points):
+        if not math.isfinite(float(beam.fibre_distance_at([x])[0])):
+            raise ScenarioError(
+                f"fatigue.points.{i}: the section there is given by area and second_moment, so its outer-fibre "
+                "distance (and the bending stress) is unknown; give width and height", key=f"fatigue.points.{i}")
+    for name in ("sn_stress", "sn_cycles", "sn_exponent"):
+        _required(fat, "fatigue", name, " (the S-N curve N(S) = sn_cycles (S / sn_stress)^-sn_exponent)")
+    kw: dict[str, Any] = {
+        "sn_stress": _positive(fat, "fatigue", "sn_stress", "stress"),
+        "sn_cycles": _positive(fat, "fatigue", "sn_cycles", "dimensionless"),
+        "sn_exponent": _positive(fat, "fatigue", "sn_exponent", "dimensionless"),
+    }
+    if "endurance_limit" in fat:
+        kw["endurance_limit"] = _nonnegative("fatigue.endurance_limit", fat["endurance_limit"], "stress")
+    kw["mean_stress"] = _choice("fatigue.mean_stress", fat.get("mean_stress", "none"), _MEAN_STRESS)
+    if "ultimate_strength" in fat:
+        kw["ultimate_strength"] = _positive(fat, "fatigue", "ultimate_strength", "stress")
+    with _relabel("fatigue"):
+        return FatigueSpec(points=points, **kw)
 
 
 def _float_list(key: str, value: list[Any]) -> tuple[float, ...]:

@@ -16,7 +16,7 @@ from typing import Any
 
 from ..exceptions import ScenarioError
 
-__all__ = ["EXCITATION_DIMENSIONS", "SUPPORT_DEFAULTS", "AMPLITUDE", "OUTPUT_FIELDS", "OUTPUT_FIELD_ALIASES", "scenario_paths", "path_dimension", "describe_value"]
+__all__ = ["EXCITATION_DIMENSIONS", "PSD_DIMENSIONS", "SUPPORT_DEFAULTS", "AMPLITUDE", "OUTPUT_FIELDS", "OUTPUT_FIELD_ALIASES", "scenario_paths", "path_dimension", "describe_value"]
 
 
 #: Physical dimension of ``excitation.amplitude`` (and of a table's values) per kind.
@@ -26,8 +26,16 @@ EXCITATION_DIMENSIONS: dict[str, str] = {
     "distributed_force": "force_per_length",
 }
 
+#: Physical dimension of the levels of ``excitation.psd`` per kind (one-sided densities).
+PSD_DIMENSIONS: dict[str, str] = {
+    "base_acceleration": "acceleration_psd",
+    "point_force": "force_psd",
+    "distributed_force": "force_per_length_psd",
+}
+
 _KINDS = ("base_acceleration", "point_force", "distributed_force", "none")
-_SHAPES = ("half_sine", "step", "table", "harmonic")
+_SHAPES = ("half_sine", "step", "table", "harmonic", "random")
+_MEAN_STRESS = ("none", "goodman")
 _HOLDS = ("constant", "linear")
 _SIDES = ("below", "above")
 #: Fields ``[output] fields`` may name: the deflection and velocity (always written), the bending
@@ -39,6 +47,8 @@ OUTPUT_FIELD_ALIASES = {"bending_moment": "moment", "bending_stress": "stress", 
 
 #: The dimension of ``excitation.amplitude``: set by ``excitation.kind`` (:data:`EXCITATION_DIMENSIONS`).
 AMPLITUDE = "amplitude"
+#: The dimension of a level of ``excitation.psd``: set by ``excitation.kind`` (:data:`PSD_DIMENSIONS`).
+PSD_LEVEL = "psd_level"
 
 
 @dataclass(frozen=True)
@@ -48,11 +58,13 @@ class _Leaf:
     ``dimension``: a key of :data:`impactbeam.units.DIMENSIONS`, ``"integer"``,
     :data:`AMPLITUDE`, or None for a word (a name, a choice, a file).
     ``list_ok``: a list of values is allowed too; ``list_only``: must be a list.
+    ``columns``: a list of rows (``[[f, G], ...]``), each with these dimensions.
     """
 
     dimension: str | None = None
     list_ok: bool = False
     list_only: bool = False
+    columns: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -103,7 +115,9 @@ _SCHEMA = _Table(
             _values(
                 kind=None, shape=None, amplitude=AMPLITUDE, duration="time", start="time", **_POSITION,
                 scale="dimensionless", file=None, hold=None, frequency="frequency", phase="angle",
+                seed="integer", stream="integer", sample_rate="frequency",
             )
+            | {"psd": _Leaf(None, True, True, ("frequency", PSD_LEVEL))}
         ),
         "initial": _Table(
             {
@@ -119,6 +133,11 @@ _SCHEMA = _Table(
             )
         ),
         "output": _Table(_values(points="length", point_ratios="dimensionless", fields=None, list_ok=True, list_only=True)),
+        "fatigue": _Table(
+            _values(points="length", list_ok=True, list_only=True)
+            | _values(sn_stress="stress", sn_cycles="dimensionless", sn_exponent="dimensionless",
+                      endurance_limit="stress", mean_stress=None, ultimate_strength="stress")
+        ),
     }
 )
 
@@ -198,10 +217,15 @@ def _check_structure(value: Any, node: Any, path: str, root: Any) -> None:
             if not node.list_ok:
                 raise ScenarioError(f"{path}: expected a single value, got a list", key=path)
             for i, item in enumerate(value):
-                if isinstance(item, (dict, list)):
+                if node.columns and not (isinstance(item, list) and len(item) == len(node.columns)):
                     raise ScenarioError(
-                        f"{_join(path, i)}: expected a value, got {describe_value(item)}", key=_join(path, i)
+                        f"{_join(path, i)}: expected a row of {len(node.columns)} values "
+                        f"({', '.join(node.columns)}), got {describe_value(item)}", key=_join(path, i)
                     )
+                for j, sub in enumerate(item if node.columns else [item]):
+                    if isinstance(sub, (dict, list)):
+                        where = _join(_join(path, i), j) if node.columns else _join(path, i)
+                        raise ScenarioError(f"{where}: expected a value, got {describe_value(sub)}", key=where)
         elif node.list_only:
             raise ScenarioError(f"{path}: expected a list, got {describe_value(value)}", key=path)
 
@@ -274,10 +298,12 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
     'force'
     """
     node: Any = _SCHEMA
+    indices: list[int] = []
     for part in path.split("."):
         if isinstance(node, _Array) and part.isdigit():
             node = node.item
-        elif isinstance(node, _Leaf) and node.list_ok and part.isdigit():
+        elif isinstance(node, _Leaf) and node.list_ok and part.isdigit() and len(indices) < 1 + bool(node.columns):
+            indices.append(int(part))
             continue
         elif isinstance(node, _Table) and part in node.fields:
             node = node.fields[part]
@@ -287,4 +313,9 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
         raise ScenarioError(f"{path}: is a table, not a value", key=path)
     if node.dimension == AMPLITUDE:
         return EXCITATION_DIMENSIONS.get(kind or "")
+    if node.columns:
+        if len(indices) < 2 or indices[1] >= len(node.columns):
+            return None  # a row or the whole table: no single dimension
+        column = node.columns[indices[1]]
+        return PSD_DIMENSIONS.get(kind or "") if column == PSD_LEVEL else column
     return node.dimension

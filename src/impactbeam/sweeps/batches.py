@@ -73,6 +73,7 @@ class _Batch:
     history_times: np.ndarray | None
     history_points: tuple[float, ...]
     on_error: str
+    statistics: bool = False
 
 
 def _make_batch(spec: SweepSpec, region: tuple[slice, ...], on_error: str) -> _Batch:
@@ -95,6 +96,7 @@ def _make_batch(spec: SweepSpec, region: tuple[slice, ...], on_error: str) -> _B
         history_times=spec.history_times() if hist is not None else None,
         history_points=hist.points if hist is not None else (),
         on_error=on_error,
+        statistics=spec.statistics,
     )
 
 
@@ -132,6 +134,15 @@ def _tune_malloc() -> None:
         pass
 
 
+def _statistics_arrays(base: Any, n: int) -> dict[str, np.ndarray]:
+    """NaN arrays for the per-case statistics of ``n`` cases (:mod:`impactbeam.statistics.record`)."""
+    from ..statistics.record import record_coordinates, record_variables
+
+    sizes = {dim: c.size for dim, c in record_coordinates(base).items()}
+    return {name: np.full((n,) if dim is None else (n, sizes[dim]), np.nan)
+            for name, (dim, _, _) in record_variables(base).items()}
+
+
 def run_batch(batch: _Batch) -> dict[str, Any]:
     """Run the cases of one batch (on a worker); per-case errors are recorded.
 
@@ -154,11 +165,16 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     ht = batch.history_times
     w = None if ht is None else np.full((n, ht.size, len(batch.history_points)), np.nan)
     base = parse_scenario(batch.base_data, base_dir=batch.base_dir, source=batch.source, name=batch.name)
+    stats = _statistics_arrays(base, n) if batch.statistics else {}
     for k, vals in enumerate(batch.values):
         try:
             sc = base.with_values(dict(zip(batch.paths, vals)))
             res = simulate(sc)
-            metrics = res.metrics(impacts=False)
+            metrics = res.metrics(impacts=False) if batch.metrics else {}
+            if stats:
+                from ..statistics.record import case_record
+
+                record = case_record(res)
             if w is not None:  # NaN after this case's end_time
                 inside = ht <= sc.solver.end_time * (1.0 + 1e-12)
                 w[k][inside] = res.displacement(list(batch.history_points), ht[inside]).T
@@ -170,8 +186,11 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
         for m in batch.metrics:
             v = metrics.get(m)
             out[m][k] = np.nan if v is None else float(v)
+        for name, arr in stats.items():
+            arr[k] = record[name]
         status[k] = res.status
         message[k] = "" if res.status == 0 else " ".join(str(res.message).split())
+    out.update(stats)
     out["status"] = status
     out["message"] = message
     if w is not None:

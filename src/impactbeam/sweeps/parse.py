@@ -22,7 +22,7 @@ __all__ = ["load_sweep", "parse_sweep"]
 
 _TOP_KEYS = ("base", "design", "samples", "seed", "parameters", "outputs", "name", "description")
 _PARAM_KEYS = ("values", "range", "scale", "distribution", "low", "high", "mean", "std")
-_OUTPUT_KEYS = ("metrics", "histories")
+_OUTPUT_KEYS = ("metrics", "histories", "statistics")
 _HISTORY_KEYS = ("points", "time_step")
 
 
@@ -223,6 +223,9 @@ def parse_sweep(
             raise err("base", str(exc)) from None
     else:
         raise err("base", f"expected a scenario path or a table, got {describe_value(raw_base)}")
+    if base.excitation.seed_drawn:  # a new draw at every reading: the sweep could not be resumed or repeated
+        raise err("base", "excitation.seed: a random load in a sweep needs its seed in the scenario (one is drawn "
+                  f"otherwise, differently at every run); add excitation.seed = {base.excitation.seed}")
 
     # design
     design = data.get("design", "grid")
@@ -278,11 +281,14 @@ def parse_sweep(
     histories = None
     if "histories" in outputs:
         histories = _histories(err, outputs["histories"], base)
+    statistics = outputs.get("statistics", False)
+    if not isinstance(statistics, bool):
+        raise err("outputs.statistics", f"expected true or false, got {describe_value(statistics)}")
 
     name = data.get("name", src.stem if src is not None else "sweep")
     if not isinstance(name, str):
         raise err("name", f"expected a string, got {describe_value(name)}")
-    spec = SweepSpec(base, design, tuple(params), samples, seed, metrics, histories, src, name)
+    spec = SweepSpec(base, design, tuple(params), samples, seed, metrics, histories, src, name, statistics)
     if histories is not None:
         spec.history_times()  # checks a bounded end time
     return spec

@@ -29,7 +29,7 @@ from .batches import (
 )
 from .parse import load_sweep, parse_sweep
 from .spec import FAILED, NOT_RUN, SweepSpec
-from .store import _StoreLock, _create_store, _open_existing
+from .store import _StoreLock, _create_store, _open_existing, statistic_names
 
 log = logging.getLogger(__name__)
 
@@ -120,7 +120,7 @@ class _Writer:
         zarr = require("zarr", "sweep")
 
         self.group = zarr.open_group(store, mode="r+")
-        self.arrays = {name: self.group[name] for name in (*spec.metrics, "message", "status")}
+        self.arrays = {name: self.group[name] for name in (*spec.metrics, *statistic_names(spec), "message", "status")}
         if spec.histories is not None:
             self.arrays["w"] = self.group["w"]
 
@@ -261,7 +261,7 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
             warnings.filterwarnings("ignore", message="Consolidated metadata", category=UserWarning)
             zarr.consolidate_metadata(store)
     ds = xr.open_zarr(store, consolidated=False, chunks=None)
-    order = [*spec.metrics, "status", "message", *(["w"] if spec.histories is not None else [])]
+    order = [*spec.metrics, *statistic_names(spec), "status", "message", *(["w"] if spec.histories is not None else [])]
     ds = ds[order]  # the store lists its arrays in no particular order
     if out_path is None:
         ds = ds.load()

@@ -156,6 +156,8 @@ class SweepSpec:
     source : Path or None
         The sweep file.
     name : str
+    statistics : bool
+        Also store each case's statistics (:data:`impactbeam.statistics.record.RECORD_VARIABLES`).
     """
 
     base: Scenario
@@ -167,6 +169,7 @@ class SweepSpec:
     histories: Histories | None
     source: Path | None = None
     name: str = "sweep"
+    statistics: bool = False
     _samples_cache: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
 
     # ------------------------------------------------------------ shape
@@ -261,6 +264,8 @@ class SweepSpec:
             out["seed"] = self.seed
         if self.histories is not None:
             out["histories"] = {"points": list(self.histories.points), "time_step": self.histories.time_step}
+        if self.statistics:
+            out["statistics"] = True
         return out
 
     @property

@@ -70,6 +70,8 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
     enc["status"] = {"chunks": chunk, "fill_value": NOT_RUN}
     data["message"] = xr.Variable(dims, da.full(shape, "", dtype=S, chunks=-1), {"long_name": "error or solver message"})
     enc["message"] = {"chunks": chunk}
+    if spec.statistics:
+        _statistics_template(spec, chunk, coords, data, enc)
     if spec.histories is not None:
         t = spec.history_times()
         pts = np.array(spec.histories.points)
@@ -102,6 +104,37 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
         attrs["seed"] = int(spec.seed or 0)
         attrs["samples"] = int(spec.samples or 0)
     return xr.Dataset(data, coords, attrs), enc
+
+
+def _statistics_template(spec: SweepSpec, chunk: tuple[int, ...], coords: dict[str, Any], data: dict[str, Any],
+                         enc: dict[str, Any]) -> None:
+    """The per-case statistics (``outputs.statistics``): variables over the case dims and their own dim."""
+    da = require("dask.array", "sweep")
+    import xarray as xr
+
+    from ..statistics.record import record_coordinates, record_variables
+
+    dims, shape = spec.dims, spec.shape
+    extra = record_coordinates(spec.base)
+    units = {"output_point": "m", "contactor": "1", "fatigue_point": "m"}
+    for dim, values in extra.items():
+        if values.size:
+            coords[dim] = xr.Variable((dim,), values, {"units": units[dim], "long_name": dim.replace("_", " ")})
+    for name, (dim, unit, long_name) in record_variables(spec.base).items():
+        tail = () if dim is None else (dim,)
+        n = () if dim is None else (extra[dim].size,)
+        data[name] = xr.Variable((*dims, *tail), da.full((*shape, *n), np.nan, chunks=-1),
+                                 {"units": unit, "long_name": long_name})
+        enc[name] = {"chunks": (*chunk, *n), "fill_value": np.nan}
+
+
+def statistic_names(spec: SweepSpec) -> tuple[str, ...]:
+    """Names of the statistics variables a sweep stores (none without ``outputs.statistics``)."""
+    if not spec.statistics:
+        return ()
+    from ..statistics.record import record_variables
+
+    return tuple(record_variables(spec.base))
 
 
 def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> Any:

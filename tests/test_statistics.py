@@ -1,0 +1,264 @@
+"""Statistics of a run: rainflow, S-N and Miner, Dirlik, impacts from the exact events, sweeps and ensembles.
+
+Independent values: ASTM E1049's published rainflow counts; a harmonic
+steady state whose stress is an exact sinusoid (Miner's damage of k cycles
+of amplitude S is k / N(S), S found by scipy's optimiser on the stress);
+Dirlik's closed form against FLife's implementation; impact statistics
+against the contact force sampled on a fine grid; Rice's crossing rate from
+the exact modes; ensembles against their members run alone.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import impactbeam as ib
+from impactbeam.cli import main
+from impactbeam.model.fatigue import FatigueSpec
+from impactbeam.statistics import (
+    cycles_to_failure,
+    dirlik_damage_rate,
+    fatigue_statistics,
+    impact_statistics,
+    miner_damage,
+    rainflow_cycles,
+    spectral_moments,
+)
+from impactbeam.statistics.record import case_record
+from random_cases import LinearReference, linear_data
+
+SPEC = FatigueSpec(points=(0.0,), sn_stress=20e6, sn_cycles=1e6, sn_exponent=8.0)
+
+
+def test_rainflow_counts_of_astm_e1049_example():
+    # ASTM E1049-85 (reapproved 2017), section 5.4.4, Fig. 6: the load sequence -2, 1, -3, 5, -1, 3,
+    # -4, 4, -2 counts ranges 3: 0.5, 4: 1.5, 6: 0.5, 8: 1.0, 9: 0.5 (its table of rainflow counts)
+    rng, _, count = rainflow_cycles([-2, 1, -3, 5, -1, 3, -4, 4, -2])
+    got: dict[float, float] = {}
+    for r, c in zip(rng, count):
+        got[float(r)] = got.get(float(r), 0.0) + float(c)
+    assert got == {3.0: 0.5, 4.0: 1.5, 6.0: 0.5, 8.0: 1.0, 9.0: 0.5}
+
+
+def test_basquin_endurance_and_goodman_by_hand():
+    spec = FatigueSpec(points=(0.0,), sn_stress=100e6, sn_cycles=1e6, sn_exponent=5.0, endurance_limit=40e6,
+                       mean_stress="goodman", ultimate_strength=400e6)
+    n = cycles_to_failure(np.array([100e6, 50e6, 50e6, 30e6, 30e6, 10e6]),
+                          np.array([0.0, 0.0, 200e6, 200e6, -100e6, 500e6]), spec)
+    assert n[0] == pytest.approx(1e6, rel=1e-15)
+    assert n[1] == pytest.approx(1e6 * 2.0**5, rel=1e-14)
+    assert n[2] == pytest.approx(1e6, rel=1e-14)  # Goodman: 50 / (1 - 200/400) = 100 MPa
+    assert n[3] == pytest.approx(1e6 * (100 / 60) ** 5, rel=1e-14)  # 30 -> 60 MPa, above the limit
+    assert math.isinf(n[4])  # compressive mean: no credit, no penalty; 30 MPa below the 40 MPa limit
+    assert n[5] == 0.0  # mean above the ultimate strength
+    damage, cyc = miner_damage([0.0, 100e6, -100e6, 100e6, -100e6, 0.0], spec)
+    assert damage == pytest.approx(cyc["count"][0] / 1e6 * 0 + np.sum(cyc["count"] / cyc["cycles_to_failure"]))
+
+
+def _harmonic_scenario() -> ib.Scenario:
+    return ib.parse_scenario({
+        "beam": linear_data()["beam"],
+        "damping": {"free": 0.02, "contact": 0.02},
+        "excitation": {"kind": "base_acceleration", "shape": "harmonic", "frequency": "40 Hz", "amplitude": "3 g"},
+        "solver": {"modes": 4, "end_time": 0.3},
+        "fatigue": {"points": [0.0, 0.03], "sn_stress": "2 MPa", "sn_cycles": 1e5, "sn_exponent": 8},
+    })
+
+
+def test_harmonic_miner_damage_is_f_over_n():
+    """No contact, the exact harmonic steady state: k cycles of amplitude S give D = k / N(S)."""
+    from scipy.optimize import minimize_scalar
+
+    from impactbeam.periodic.frf import linear_steady_state
+
+    sc = _harmonic_scenario()
+    res = ib.simulate(sc, start=linear_steady_state(sc))
+    f, k = 40.0, 8
+    for x in sc.fatigue.points:
+        t = np.linspace(0.0, 1.0 / f, 401)
+        s = res.bending_stress([x], t)[0]
+        i = int(np.argmax(np.abs(s)))
+        opt = minimize_scalar(lambda tt: -abs(res.bending_stress([x], [tt])[0, 0]),
+                              bounds=(t[max(i - 1, 0)], t[i + 1]), method="bounded", options={"xatol": 1e-13})
+        tp, amp = float(opt.x), -float(opt.fun)
+        out = fatigue_statistics(res, sc.fatigue, window=(tp, tp + k / f))
+        row = out[[p["point"] for p in out].index(x)]
+        n_s = 1e5 * (amp / 2e6) ** -8
+        # tolerance 1e-9: the turning points are exact to ~1e-12 relative, raised to the power m = 8
+        assert row["cycles"] == pytest.approx(k, abs=1e-12)
+        assert row["damage"] == pytest.approx(k / n_s, rel=1e-9)
+        assert row["damage_rate"] == pytest.approx(f / n_s, rel=1e-9)
+        assert row["life"] == pytest.approx(n_s / f, rel=1e-9)
+
+
+def test_dirlik_against_flife():
+    """Our closed form of Dirlik's damage against FLife's implementation on the same density."""
+    flife = pytest.importorskip("FLife")
+    f = np.linspace(0.0, 500.0, 5001)
+    g = 1e12 * (np.exp(-((f - 60.0) / 8.0) ** 2) + 0.3 * np.exp(-((f - 350.0) / 20.0) ** 2))  # Pa^2/Hz
+    m = spectral_moments(f, g)
+    ours = dirlik_damage_rate(m, sn_stress=20e6, sn_cycles=1e6, sn_exponent=6.0)
+    sd = flife.SpectralData(input={"PSD": g, "f": f})
+    life = flife.Dirlik(sd).get_life(C=1e6 * (20e6) ** 6, k=6.0)
+    # tolerance 1e-6: both use the same closed form; the moments are trapezoid sums on one grid
+    assert ours == pytest.approx(1.0 / life, rel=1e-6)
+
+
+def test_impact_statistics_of_a_transient_against_the_sampled_force(scenario_file):
+    import specimen
+
+    text = specimen.BEAM + specimen.CONTACTOR + """
+[damping]
+free = 0.011
+contact = 0.02
+[excitation]
+kind = "base_acceleration"
+shape = "half_sine"
+amplitude = "15 g"
+duration = "15 ms"
+[solver]
+modes = 8
+time_step = 1e-6
+end_time = 0.2
+"""
+    sc = ib.load_scenario(scenario_file(text))
+    res = ib.simulate(sc)
+    st = impact_statistics(res)
+    c0 = st.contactors[0]
+    m = res.metrics()
+    assert st.window == (0.0, 0.2)
+    assert c0["n_impacts"] == m["n_impacts"] and c0["rate"] == pytest.approx(m["n_impacts"] / 0.2, rel=1e-15)
+    assert c0["peak_force_max"] == max(r["peak_force"] for r in m["impacts"])
+    # the contact force sampled every microsecond (independent of the quadrature): tolerance 1e-4,
+    # the trapezoid rule's error on 1 us steps at the contact's kinks
+    F = res.contact_force[:, 0]
+    dt = res.time_step
+    assert c0["force_rms"] == pytest.approx(math.sqrt(np.trapezoid(F**2, dx=dt) / 0.2), rel=1e-4)
+    assert c0["force_mean"] == pytest.approx(np.trapezoid(F, dx=dt) / 0.2, rel=1e-4)
+    assert c0["contact_fraction"] == pytest.approx(np.mean(res.engaged[:, 0]), abs=2e-5)
+    # the JSON of simulate: the statistics and the table
+    out = CliRunner().invoke(main, ["simulate", str(sc.source), "--json"], catch_exceptions=False)
+    data = json.loads(out.stdout)
+    assert data["impact_statistics"][0]["rate"] == c0["rate"] and "fatigue" not in data
+    out = CliRunner().invoke(main, ["simulate", str(sc.source)], catch_exceptions=False)
+    assert "impacts per second" in out.stdout
+
+
+def test_simulate_json_has_fatigue_with_a_fatigue_table(scenario_file):
+    sc = _harmonic_scenario()
+    path = scenario_file(sc.to_toml())
+    out = CliRunner().invoke(main, ["simulate", str(path), "--json"], catch_exceptions=False)
+    data = json.loads(out.stdout)
+    assert [p["point"] for p in data["fatigue"]] == [0.0, 0.03]
+    assert all(p["damage_rate"] > 0 and p["life"] == pytest.approx(1 / p["damage_rate"]) for p in data["fatigue"])
+
+
+def test_ensemble_members_repeat_alone_and_sweeps_store_statistics(tmp_path):
+    """A member of an ensemble is the scenario with its stream: the same bits when run alone."""
+    data = linear_data(end_time=3.0)
+    data["contactors"] = [{"position": 0.1092, "stiffness": 4030, "gap": "0.4 mm", "side": "below"}]
+    data["fatigue"] = {"points": [0.0], "sn_stress": "2 MPa", "sn_cycles": 1e5, "sn_exponent": 8}
+    sc = ib.parse_scenario(data)
+    ens = ib.random_response(sc, seeds=2, workers=0, out=tmp_path / "ens")
+    alone = case_record(ib.simulate(sc.with_values({"excitation.stream": 1})))
+    ds = ens.dataset.sel({"excitation.stream": 1})
+    for name, value in alone.items():
+        assert np.array_equal(np.asarray(ds[name].values), np.asarray(value), equal_nan=True), name
+    d = ens.to_dict()
+    for key in ("seeds", "duration", "points", "rms", "rms_ci", "rms_velocity", "impacts", "fatigue"):
+        assert key in d
+    assert set(d["impacts"][0]) >= {"rate", "rate_ci", "force_rms", "peak_force_mean", "peak_force_max",
+                                     "contact_fraction", "duration_mean", "impulse_mean"}
+    assert set(d["fatigue"][0]) >= {"damage_rate", "damage_rate_ci", "life"}
+    # the rate is the mean of the members' rates, its interval brackets it
+    rates = np.asarray(ens.dataset["impact_rate"].values)[:, 0]
+    assert d["impacts"][0]["rate"] == pytest.approx(np.mean(rates), rel=1e-15)
+    assert d["impacts"][0]["rate_ci"][0] <= d["impacts"][0]["rate"] <= d["impacts"][0]["rate_ci"][1]
+    # resumed from its store: nothing recomputed, the same numbers
+    again = ib.random_response(sc, seeds=2, workers=0, out=tmp_path / "ens")
+    assert again.to_dict() == d
+
+
+def test_bad_ensemble_input_exits_2(scenario_file):
+    path = scenario_file(ib.parse_scenario(linear_data(end_time=1.0)).to_toml())
+    for args, key in ((["--seeds", "0"], "--seeds"), (["--seeds", "2", "--workers", "-1"], "--workers")):
+        out = CliRunner().invoke(main, ["random", str(path), *args], catch_exceptions=False)
+        assert out.exit_code == 2 and out.stderr.startswith(f"error: {key}")
+    harmonic = scenario_file(_harmonic_scenario().to_toml(), "h.toml")
+    out = CliRunner().invoke(main, ["random", str(harmonic), "--seeds", "2"], catch_exceptions=False)
+    assert out.exit_code == 2 and out.stderr.startswith("error: excitation.shape:")
+
+
+@pytest.mark.slow
+def test_impact_rate_of_a_very_soft_far_stop_is_rices_rate():
+    """A stop of 1e-3 N/m (3e-5 of 3 EI/L^3) at 1.5 sigma below the tip changes nothing: each impact is a
+    down-crossing of -b, so the impact rate is Rice's nu_0 exp(-b^2 / 2 sigma^2) of the linear tip motion
+    (sigma, sigma_v from the exact modes). Checked against the ensemble's 99 % interval (4 seeds of 40 s,
+    ~720 impacts each; measured spread of the seeds 1 %)."""
+    from impactbeam.statistics import rice_rate
+
+    base = ib.parse_scenario(linear_data(end_time=40.0, points=(0.1092,)))
+    ref = LinearReference(base)
+    sigma, sigma_v = np.sqrt(ref.variance()[0]), np.sqrt(ref.variance(True)[0])
+    b = 1.5 * sigma
+    data = linear_data(end_time=40.0, points=(0.1092,))
+    data["contactors"] = [{"position": 0.1092, "stiffness": 1e-3, "gap": b, "side": "below"}]
+    ens = ib.random_response(ib.parse_scenario(data), seeds=4, workers=0, confidence=0.99)
+    imp = ens.impacts[0]
+    nu = rice_rate(b, sigma, sigma_v)
+    assert imp["rate_ci"][0] <= nu <= imp["rate_ci"][1]
+    assert imp["rate"] == pytest.approx(nu, rel=0.03)
+
+
+@pytest.mark.slow
+@pytest.mark.dask
+def test_same_seed_same_bits_on_one_or_four_workers():
+    data = linear_data(end_time=3.0)
+    data["contactors"] = [{"position": 0.1092, "stiffness": 4030, "gap": "0.4 mm", "side": "below"}]
+    sc = ib.parse_scenario(data)
+    one = ib.random_response(sc, seeds=4, workers=1)
+    four = ib.random_response(sc, seeds=4, workers=4)
+    for name in one.dataset.data_vars:
+        assert np.array_equal(one.dataset[name].values, four.dataset[name].values,
+                              equal_nan=name != "message"), name
+    assert one.to_dict() == four.to_dict()
+
+
+def test_sweep_over_gap_and_level_stores_the_statistics():
+    """The impact-rate-vs-clearance curve: a sweep of gaps and load levels (excitation.scale: the density
+    times its square) stores each case's statistics, equal to those of the case run alone."""
+    data = linear_data(end_time=2.5)
+    data["contactors"] = [{"position": 0.1092, "stiffness": 4030, "gap": "0.4 mm", "side": "below"}]
+    base = ib.parse_scenario(data)
+    spec = {"base": base.data, "parameters": {"contactors.0.gap": {"values": ["0.3 mm", "0.6 mm"]},
+                                              "excitation.scale": {"values": [1.0, 2.0]}},
+            "outputs": {"metrics": ["n_impacts"], "statistics": True}}
+    ds = ib.sweep(spec, workers=0, progress=False)
+    assert ds["impact_rate"].dims == ("contactors.0.gap", "excitation.scale", "contactor")
+    assert ds["impact_rate"].attrs["units"] == "1/s" and ds["rms"].dims[-1] == "output_point"
+    case = base.with_values({"contactors.0.gap": "0.6 mm", "excitation.scale": 2.0})
+    alone = impact_statistics(ib.simulate(case)).contactors[0]
+    got = ds["impact_rate"].sel({"contactors.0.gap": 0.6e-3, "excitation.scale": 2.0}).values[0]
+    assert got == alone["rate"]
+    rates = ds["impact_rate"].values[..., 0]
+    assert rates[0, 1] > rates[1, 1] and rates[1, 1] > rates[1, 0]  # closer or harder: more impacts
+
+
+def test_random_figures(tmp_path):
+    pytest.importorskip("matplotlib")
+    from impactbeam.plot.random import plot_input_psd, plot_random
+
+    data = linear_data(end_time=3.0, points=(0.1092,))
+    data["contactors"] = [{"position": 0.1092, "stiffness": 4030, "gap": "0.4 mm", "side": "below"}]
+    res = ib.simulate(ib.parse_scenario(data))
+    h = plot_random(res, path=tmp_path / "random.png", dpi=80)
+    assert len(h.axes) == 4 and (tmp_path / "random.png").stat().st_size > 10_000
+    assert [ax.get_xlabel() for ax in h.axes] == ["frequency [Hz]", "frequency [Hz]", "peak impact force [N]",
+                                                  "stress range at x = 0 mm [MPa]"]
+    with pytest.raises(ib.ParameterError, match="random"):
+        plot_input_psd(_harmonic_scenario().excitation)
