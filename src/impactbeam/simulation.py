@@ -101,6 +101,7 @@ def simulate_system(
         raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
     _check_distinct(contactors)
     _check_supported(contactors, damping)
+    _check_initial_supported(initial)
     if method not in ("exact", "ivp"):
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
     _check_start(start, beam, contactors, options, method)
@@ -167,6 +168,16 @@ def _check_supported(contactors: tuple[Contactor, ...], damping: Damping) -> Non
             raise ParameterError(f"contactors.{i}.damping: contactor dashpots are not supported by this version")
     if damping.model == "free_modes":
         raise ParameterError('damping.model: "free_modes" is not supported by this version')
+
+
+def _check_initial_supported(initial: InitialCondition) -> None:
+    """Refuse the initial states the engine does not take yet (until it calls ``solver.initial.initial_coordinates``)."""
+    for name in ("velocity", "angular_velocity", "displacement_profile", "velocity_profile"):
+        if getattr(initial, name) is not None:
+            key = name.replace("_profile", "")
+            raise ParameterError(f"initial.{key}: not supported by this version of the solver")
+    if initial.equilibrium:
+        raise ParameterError("initial.equilibrium: not supported by this version of the solver")
 
 
 def _check_distinct(contactors: tuple[Contactor, ...]) -> None:
@@ -267,6 +278,8 @@ def simulate(
     are also listed in ``result.warnings``.
     """
     _require_scenario(scenario)
+    if scenario.preload is not None:
+        raise ParameterError("preload: not supported by this version of the solver")
     res = simulate_system(
         scenario.beam,
         scenario.contactors,

@@ -69,6 +69,8 @@ DIMENSIONS: dict[str, _Dimension] = {
     "rotary_inertia": _Dimension("kg m^2", "kg*m^2", "a rotary inertia"),
     "damping_coefficient": _Dimension("N s/m", "N*s/m", "a damping coefficient"),
     "rate": _Dimension("1/s", "1/s", "a rate (per second)"),
+    "velocity": _Dimension("m/s", "m/s", "a velocity"),
+    "angular_velocity": _Dimension("rad/s", "rad/s", "an angular velocity"),
     "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
 }
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from ..exceptions import ScenarioError
 
-__all__ = ["EXCITATION_DIMENSIONS", "SUPPORT_DEFAULTS", "AMPLITUDE", "OUTPUT_FIELDS", "OUTPUT_FIELD_ALIASES", "scenario_paths", "path_dimension", "describe_value"]
+__all__ = ["EXCITATION_DIMENSIONS", "PRELOAD_DIMENSIONS", "SUPPORT_DEFAULTS", "AMPLITUDE", "PRELOAD_AMPLITUDE", "OUTPUT_FIELDS", "OUTPUT_FIELD_ALIASES", "scenario_paths", "path_dimension", "describe_value"]
 
 
 #: Physical dimension of ``excitation.amplitude`` (and of a table's values) per kind.
@@ -39,6 +39,15 @@ OUTPUT_FIELD_ALIASES = {"bending_moment": "moment", "bending_stress": "stress", 
 
 #: The dimension of ``excitation.amplitude``: set by ``excitation.kind`` (:data:`EXCITATION_DIMENSIONS`).
 AMPLITUDE = "amplitude"
+#: The dimension of ``preload.amplitude``: set by ``preload.kind`` (:data:`PRELOAD_DIMENSIONS`).
+PRELOAD_AMPLITUDE = "preload_amplitude"
+#: Physical dimension of ``preload.amplitude`` per ``preload.kind``.
+PRELOAD_DIMENSIONS: dict[str, str] = {
+    "gravity": "acceleration",
+    "base_acceleration": "acceleration",
+    "point_force": "force",
+}
+_PRELOAD_KINDS = tuple(PRELOAD_DIMENSIONS)
 
 
 @dataclass(frozen=True)
@@ -46,13 +55,16 @@ class _Leaf:
     """A value.
 
     ``dimension``: a key of :data:`impactbeam.units.DIMENSIONS`, ``"integer"``,
-    :data:`AMPLITUDE`, or None for a word (a name, a choice, a file).
+    :data:`AMPLITUDE`, :data:`PRELOAD_AMPLITUDE`, or None for a word (a name, a choice, a file).
     ``list_ok``: a list of values is allowed too; ``list_only``: must be a list.
+    ``rows``: a table of ``[x, value]`` rows (x a length) is allowed too; with
+    ``list_only`` it must be one.
     """
 
     dimension: str | None = None
     list_ok: bool = False
     list_only: bool = False
+    rows: bool = False
 
 
 @dataclass(frozen=True)
@@ -110,8 +122,13 @@ _SCHEMA = _Table(
                 **_values(tip_displacement="length", position="length"),
                 **_values(modal_displacement="dimensionless", modal_velocity="dimensionless",
                           list_ok=True, list_only=True),
+                "velocity": _Leaf("velocity", rows=True),
+                "displacement": _Leaf("length", list_only=True, rows=True),
+                **_values(angular_velocity="angular_velocity", pivot="length", displacement_file=None,
+                          velocity_file=None, equilibrium=None),
             }
         ),
+        "preload": _Table({**_values(kind=None, amplitude=PRELOAD_AMPLITUDE, **_POSITION)}),
         "solver": _Table(
             _values(
                 modes="integer", time_step="time", end_time="time", max_events="integer", event_tolerance="time",
@@ -194,7 +211,9 @@ def _check_structure(value: Any, node: Any, path: str, root: Any) -> None:
     else:
         if isinstance(value, dict):
             raise ScenarioError(f"{path}: expected a value, got a table", key=path)
-        if isinstance(value, list):
+        if isinstance(value, list) and node.rows:
+            _check_rows(value, path)
+        elif isinstance(value, list):
             if not node.list_ok:
                 raise ScenarioError(f"{path}: expected a single value, got a list", key=path)
             for i, item in enumerate(value):
@@ -204,6 +223,17 @@ def _check_structure(value: Any, node: Any, path: str, root: Any) -> None:
                     )
         elif node.list_only:
             raise ScenarioError(f"{path}: expected a list, got {describe_value(value)}", key=path)
+
+
+def _check_rows(value: list[Any], path: str) -> None:
+    """A table of ``[x, value]`` rows: each a list of two values."""
+    for i, row in enumerate(value):
+        where = _join(path, i)
+        if not (isinstance(row, list) and len(row) == 2 and not any(isinstance(v, (list, dict)) for v in row)):
+            raise ScenarioError(
+                f"{where}: expected a row [x, value] (e.g. [\"0.5 m\", \"1 mm\"]), got {describe_value(row)}",
+                key=where,
+            )
 
 
 def scenario_paths(data: Mapping[str, Any] | None = None) -> list[str]:
@@ -240,7 +270,7 @@ def scenario_paths(data: Mapping[str, Any] | None = None) -> list[str]:
     return out
 
 
-def path_dimension(path: str, kind: str | None = None) -> str | None:
+def path_dimension(path: str, kind: str | None = None, preload_kind: str | None = None) -> str | None:
     """The dimension in which the value at a dotted scenario path is read.
 
     The one rule for the units of every scenario key: the scenario parser,
@@ -254,6 +284,8 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
         ``"damping.free.2"``, ``"output.points.1"``).
     kind : str, optional
         ``excitation.kind``, which sets the dimension of ``excitation.amplitude``.
+    preload_kind : str, optional
+        ``preload.kind``, which sets the dimension of ``preload.amplitude``.
 
     Returns
     -------
@@ -274,9 +306,13 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
     'force'
     """
     node: Any = _SCHEMA
-    for part in path.split("."):
+    parts = path.split(".")
+    for depth, part in enumerate(parts):
         if isinstance(node, _Array) and part.isdigit():
             node = node.item
+        elif isinstance(node, _Leaf) and node.rows and part.isdigit() and len(parts) - depth == 2 \
+                and parts[-1] in ("0", "1"):
+            return "length" if parts[-1] == "0" else node.dimension  # [x, value] row, column
         elif isinstance(node, _Leaf) and node.list_ok and part.isdigit():
             continue
         elif isinstance(node, _Table) and part in node.fields:
@@ -287,4 +323,6 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
         raise ScenarioError(f"{path}: is a table, not a value", key=path)
     if node.dimension == AMPLITUDE:
         return EXCITATION_DIMENSIONS.get(kind or "")
+    if node.dimension == PRELOAD_AMPLITUDE:
+        return PRELOAD_DIMENSIONS.get(preload_kind or "")
     return node.dimension
