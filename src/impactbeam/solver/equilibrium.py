@@ -44,6 +44,7 @@ References
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Sequence
@@ -55,7 +56,7 @@ import scipy.optimize
 
 from ..exceptions import ParameterError
 from ..modal import static_state
-from ..model.beam import Beam, Contactor
+from ..model.beam import Beam, Contactor, InteriorSpring
 from ..model.loading import Preload, spatial_projection
 
 __all__ = ["Equilibrium", "ContinuumEquilibrium", "preload_weights", "modal_equilibrium", "continuum_equilibrium"]
@@ -93,11 +94,14 @@ class ContinuumEquilibrium:
     Attributes
     ----------
     beam : Beam
+        The beam the static solver sees (with the engaged contactors as
+        springs when only they hold it).
     engaged : tuple of int
     forces : ndarray, (n_contactors,), [N]
         Contact force of every contactor (>= 0).
     loads : tuple of (position [m], force [N])
-        Point forces along +w (preload, point masses, contact forces).
+        Point forces along +w (preload, point masses, and the contact forces
+        or, with the contactors as springs, their gaps' forces).
     per_length : tuple of float, [N/m]
         Distributed load per section along +w.
     """
@@ -272,16 +276,23 @@ def _preload_loads(beam: Beam, preload: Preload) -> tuple[list[tuple[float, floa
     return [(m.position, m.mass * acc) for m in beam.masses if m.mass], per_length
 
 
+def _held_by(beam: Beam, contactors: Sequence[Contactor], engaged: Sequence[int]) -> Beam:
+    """The beam with the engaged contactors as permanent springs (for the static solver)."""
+    springs = tuple(InteriorSpring(contactors[i].position, contactors[i].stiffness) for i in engaged)
+    return dataclasses.replace(beam, springs=beam.springs + springs)
+
+
 def continuum_equilibrium(beam: Beam, preload: Preload, contactors: Sequence[Contactor]) -> ContinuumEquilibrium:
     """The exact static contact solution (continuum, no modes) under ``preload``.
 
     The same LCP as the modal problem, with the exact flexibility at the
-    contactors from :func:`impactbeam.modal.static_state`.
+    contactors from :func:`impactbeam.modal.static_state`; a beam that only
+    its stops hold (free-free on two stops) by the engaged sets, each solved
+    with its contactors as springs.
 
     Parameters
     ----------
     beam : Beam
-        Held by its supports (the static solver needs no rigid-body motion).
     preload : Preload
     contactors : sequence of Contactor
 
@@ -292,17 +303,39 @@ def continuum_equilibrium(beam: Beam, preload: Preload, contactors: Sequence[Con
     Raises
     ------
     ParameterError
-        If the supports let the beam move as a rigid body.
+        When nothing holds the beam against the preload (no equilibrium).
     """
     contactors = tuple(contactors)
     s, k, gap = _sides(contactors)
     loads, per_length = _preload_loads(beam, preload)
     a = [c.position for c in contactors]
-    lam = np.zeros(len(contactors))
-    if contactors:
-        w0 = static_state(beam, a, loads, per_length)[0]
-        F = np.array([static_state(beam, a, [(aj, 1.0)])[0] for aj in a]).T  # F[i, j]: w(a_i) per unit force at a_j
-        lam = _lcp(s[:, None] * F * s[None, :], s * w0 - gap, k)
-    engaged = tuple(int(i) for i in np.flatnonzero(lam > 0.0))
-    contact = [(a[i], float(-s[i] * lam[i])) for i in engaged]
-    return ContinuumEquilibrium(beam, engaged, lam, tuple(loads + contact), tuple(per_length))
+    try:
+        lam = np.zeros(len(contactors))
+        if contactors:
+            w0 = static_state(beam, a, loads, per_length)[0]
+            F = np.array([static_state(beam, a, [(aj, 1.0)])[0] for aj in a]).T  # F[i, j]: w(a_i) per unit force at a_j
+            lam = _lcp(s[:, None] * F * s[None, :], s * w0 - gap, k)
+        engaged = tuple(int(i) for i in np.flatnonzero(lam > 0.0))
+        contact = [(a[i], float(-s[i] * lam[i])) for i in engaged]
+        return ContinuumEquilibrium(beam, engaged, lam, tuple(loads + contact), tuple(per_length))
+    except ParameterError:
+        pass  # the supports let the beam move: only its stops can hold it
+    tol = 1e-12 * beam.length
+    for size in range(1, min(len(contactors), MAX_ENUMERATED) + 1):
+        for engaged in itertools.combinations(range(len(contactors)), size):
+            held = _held_by(beam, contactors, engaged)
+            gaps = [(a[i], float(s[i] * k[i] * gap[i])) for i in engaged]
+            try:
+                w = static_state(held, a, loads + gaps, per_length)[0]
+            except ParameterError:
+                continue
+            g = gap - s * w
+            on = np.zeros(len(contactors), dtype=bool)
+            on[list(engaged)] = True
+            if np.all(g[on] <= tol) and np.all(g[~on] >= -tol):
+                forces = np.where(on, k * np.maximum(-g, 0.0), 0.0)
+                return ContinuumEquilibrium(held, tuple(engaged), forces, tuple(loads + gaps), tuple(per_length))
+    raise ParameterError(
+        "initial.equilibrium: no static equilibrium exists under the preload: the supports and the contactors "
+        "it engages do not hold the beam"
+    )

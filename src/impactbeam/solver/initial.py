@@ -233,8 +233,14 @@ def _truncation(space, beam: Beam, preload: Preload, contactors: Sequence[Contac
     """Warn when the modal equilibrium differs from the exact static contact solution by more than RESIDUAL_WARNING."""
     try:
         exact = continuum_equilibrium(beam, preload, contactors)
-    except ParameterError:
-        return  # held only by its stops: the static solver needs supports that hold the beam
+    except ParameterError:  # the model holds the beam, the continuum does not: certainly truncated
+        exact = None
+    if exact is None:
+        emit_user_level_warning(
+            f"initial.equilibrium: the run's model finds an equilibrium (contactors {list(engaged)} engaged) that "
+            "the exact static solution does not have; add modes"
+        )
+        return
     modes = space.state(engaged).modes
     field = Field(lambda x: exact.deflection(x)[0], lambda x: exact.deflection(x)[1], "initial.equilibrium",
                   tuple(p for p, _ in exact.loads))
