@@ -42,6 +42,16 @@ Method
   in general it satisfies the exact discrete balance
   ``E_{n+1} - E_n = 1/2 du.(f_n + f_{n+1}) - du^T C du / h``,
   which this module accumulates as ``work`` and ``dissipated``.
+* Dissipation (:func:`fe_transient_dissipative`, Newmark, and
+  :func:`fe_transient_exact`, the same FE model integrated exactly in time by
+  matrix exponentials): a dashpot in parallel with each contactor (force
+  ``k d + c d'`` while positive, released where it reaches 0, code_aster's
+  ``AMOR_NOR`` law) and the beam damping models ``modal`` (per state),
+  ``rayleigh`` (``alpha M + beta K_s``) and ``free_modes`` (the free state's
+  modal damping matrix kept in every state). A dashpot's force jump at an
+  impact excites the fast modes, which Newmark keeps with wrong phases (a
+  release moves by microseconds); the exact integrator leaves only the mesh
+  to converge.
 """
 
 from __future__ import annotations
