@@ -42,6 +42,16 @@ Method
   in general it satisfies the exact discrete balance
   ``E_{n+1} - E_n = 1/2 du.(f_n + f_{n+1}) - du^T C du / h``,
   which this module accumulates as ``work`` and ``dissipated``.
+* Dissipation (:func:`fe_transient_dissipative`, Newmark, and
+  :func:`fe_transient_exact`, the same FE model integrated exactly in time by
+  matrix exponentials): a dashpot in parallel with each contactor (force
+  ``k d + c d'`` while positive, released where it reaches 0, code_aster's
+  ``AMOR_NOR`` law) and the beam damping models ``modal`` (per state),
+  ``rayleigh`` (``alpha M + beta K_s``) and ``free_modes`` (the free state's
+  modal damping matrix kept in every state). A dashpot's force jump at an
+  impact excites the fast modes, which Newmark keeps with wrong phases (a
+  release moves by microseconds); the exact integrator leaves only the mesh
+  to converge.
 """
 
 from __future__ import annotations
@@ -63,6 +73,10 @@ __all__ = [
     "element_matrices",
     "fe_modes",
     "fe_transient",
+    "fe_transient_dissipative",
+    "fe_transient_exact",
+    "ExactResult",
+    "DissipativeResult",
     "hermite_shape",
     "solve_modes",
     "strain_energy",
@@ -841,4 +855,753 @@ def fe_transient(
         dissipated=DISS,
         x_nodes=model.x.copy(),
         n_factorisations=n_fact[0],
+    )
+
+
+# --------------------------------------------------------------------------
+# Dissipative contact and beam damping models
+# --------------------------------------------------------------------------
+@dataclass
+class DissipativeResult(TransientResult):
+    """Output of :func:`fe_transient_dissipative` (the fields of :class:`TransientResult`, and):
+
+    ``contact_force`` (n_t, n_contactors) is ``k d + c d'`` of the engaged
+    contactors (>= 0, the magnitude pushing the beam back), ``penetration``
+    (n_t, n_contactors) ``d = s w(a) - gap``; ``event_state`` per event
+    ``(d, d', force before, force after)`` of the switching contactor;
+    ``dashpot`` (n_t,) cumulative energy dissipated by the contactor dashpots
+    (incl. the spring energy ``1/2 k d^2`` left in a contactor released at
+    ``d > 0``, which its dashpot dissipates as it relaxes), ``dissipated`` the
+    beam's and the dashpots' together; ``engagement_work`` (n_t,) cumulative
+    ``1/2 k d^2`` of contactors engaged at ``d > 0`` (booked as work, so the
+    balance stays exact).
+    """
+
+    penetration: np.ndarray = field(default=None)
+    event_state: list = field(default_factory=list)
+    dashpot: np.ndarray = field(default=None)
+    engagement_work: np.ndarray = field(default=None)
+
+
+def _beam_damping(model: FEModel, spec: dict, Ks: np.ndarray, engaged: bool, C_free: list) -> np.ndarray:
+    """The beam's damping matrix in a state (reduced DOFs), by ``spec["model"]``.
+
+    ``modal``: ``M Phi diag(2 xi omega) Phi^T M`` on all FE modes of the state
+    (``xi = spec["free"]`` or ``spec["contact"]``); ``rayleigh``: ``alpha M +
+    beta K_s`` (``K_s`` with the engaged contact springs); ``free_modes``: the
+    modal matrix of the FREE state's FE modes with ``spec["free"]``, the same
+    in every state (``C_free`` caches it).
+    """
+    kind = spec.get("model", "modal")
+    Mr = model.M_r
+    if kind == "rayleigh":
+        return float(spec.get("alpha", 0.0)) * Mr + float(spec.get("beta", 0.0)) * Ks
+    if kind == "free_modes":
+        if not C_free:
+            C_free.append(_beam_damping(model, {"model": "modal", "free": spec["free"]}, model.K_r, False, []))
+        return C_free[0]
+    if kind != "modal":
+        raise ValueError(f"unknown damping model {kind!r}")
+    xi = float(spec.get("contact", 0.0) if engaged else spec.get("free", 0.0))
+    if xi == 0.0:
+        return np.zeros_like(Mr)
+    lam, phi = _eig_all(Ks, Mr)
+    MP = Mr @ phi
+    C = (MP * (2.0 * xi * np.sqrt(lam))) @ MP.T
+    return 0.5 * (C + C.T)
+
+
+def fe_transient_dissipative(
+    length: float,
+    EI: float,
+    rhoA: float,
+    *,
+    left: tuple[float, float],
+    right: tuple[float, float],
+    contactors: Sequence[dict] = (),
+    load: dict | None = None,
+    initial: dict | None = None,
+    damping: dict | None = None,
+    dt: float,
+    t_end: float,
+    output_x: Sequence[float] | None = None,
+    n_elements: int = 50,
+    **structure: Sequence,
+) -> DissipativeResult:
+    """Newmark transient with contactor dashpots (force release) and the three beam damping models.
+
+    Parameters as :func:`fe_transient`, except:
+
+    contactors : dicts ``{"position", "stiffness", "gap", "side", "damping"=0}``.
+        With the penetration ``d = s w(a) - gap`` (s = +1 above, -1 below) the
+        contactor pushes the beam back with ``F = k d + c d'`` while engaged.
+        It engages when ``d > 0`` and ``F > 0`` (at ``d = 0`` moving in: ``F =
+        c d' > 0``; or, still penetrated after a release, when ``F`` turns
+        positive) and is released when ``F`` reaches 0 (before ``d`` does when
+        ``c > 0``): it never pulls. ``c = 0`` is the contactor of
+        :func:`fe_transient`.
+    damping : ``{"model": "modal", "free": xi_f, "contact": xi_c}`` (default,
+        undamped), ``{"model": "rayleigh", "alpha": a, "beta": b}`` (``C = a M
+        + b K_s``, ``K_s`` with the engaged springs), or ``{"model":
+        "free_modes", "free": xi}`` (the free state's modal damping matrix on
+        all its FE modes, kept in every state). The dashpots add to it.
+
+    Method
+    ------
+    As :func:`fe_transient`; the switching function of contactor ``i`` is
+    ``h = F/k`` while engaged (released where it falls to 0) and ``h =
+    min(d, F/k)`` while free (engaged where it rises above 0), both located
+    inside a step by Brent's method on re-done Newmark steps (xtol 1e-14 s),
+    never snapped to the grid. Energies: the discrete balance of the
+    average-acceleration rule, ``dissipated`` including the dashpots.
+    """
+    contactors = [dict(c) for c in contactors]
+    sides = []
+    for c in contactors:
+        if c.get("side") not in ("above", "below"):
+            raise ValueError("contactor side must be 'above' or 'below'")
+        if not (c["stiffness"] > 0 and math.isfinite(c["stiffness"])):
+            raise ValueError("contactor stiffness must be positive and finite")
+        if not (c["gap"] >= 0 and c.get("damping", 0.0) >= 0):
+            raise ValueError("contactor gap and damping must be >= 0")
+        sides.append(1.0 if c["side"] == "above" else -1.0)
+    spec = dict(damping) if damping else {"model": "modal"}
+    load = dict(load) if load else {"kind": "none"}
+    kind = load.get("kind", "none")
+    if output_x is None:
+        output_x = [c["position"] for c in contactors] + [length]
+    extra_nodes = [c["position"] for c in contactors] + ([load["position"]] if kind == "point_force" else [])
+    model = assemble(length, EI, rhoA, n_elements=n_elements, left=left, right=right, nodes_at=extra_nodes,
+                     **structure)
+    free = model.free
+    Kr, Mr = model.K_r, model.M_r
+    nf = len(free)
+    cdof = [model.reduced_index(2 * model.node_index(c["position"])) for c in contactors]
+    ck = np.array([float(c["stiffness"]) for c in contactors])
+    cc = np.array([float(c.get("damping", 0.0)) for c in contactors])
+    cgap = np.array([float(c["gap"]) for c in contactors])
+    cs = np.array(sides)
+    nc = len(contactors)
+
+    fvec = np.zeros(nf)
+    if kind == "base_acceleration":
+        r = np.zeros(model.n_dof)
+        r[0::2] = 1.0
+        fvec = -(model.M @ r)[free]
+    elif kind == "point_force":
+        fvec[model.reduced_index(2 * model.node_index(load["position"]))] = 1.0
+    elif kind not in ("none", None):
+        raise ValueError(f"unknown load kind {kind!r}")
+    a0_ = float(load.get("amplitude", 0.0))
+    shape_ = load.get("shape", "half_sine" if kind == "base_acceleration" else "step")
+    st_, du_ = float(load.get("start", 0.0)), load.get("duration")
+    fr_, ph_ = load.get("frequency"), float(load.get("phase", 0.0))
+
+    def amp(t: float) -> float:
+        return 0.0 if kind in ("none", None) else _pulse(t, shape_, a0_, st_, du_, fr_, ph_)
+
+    state_cache: dict[tuple, tuple] = {}
+    factor_cache: dict[tuple, tuple] = {}
+    C_free: list = []
+    n_fact = [0]
+
+    def state(key: tuple) -> tuple:
+        """(K_s, fc_s, C_s) of the engaged set ``key``: springs, gap forces, beam damping + dashpots."""
+        if key not in state_cache:
+            Ks = Kr.copy()
+            fc = np.zeros(nf)
+            for i, on in enumerate(key):
+                if on:
+                    Ks[cdof[i], cdof[i]] += ck[i]
+                    fc[cdof[i]] += cs[i] * ck[i] * cgap[i]
+            C = _beam_damping(model, spec, Ks, any(key), C_free).copy()
+            for i, on in enumerate(key):
+                if on:
+                    C[cdof[i], cdof[i]] += cc[i]
+            state_cache[key] = (Ks, fc, C)
+        return state_cache[key]
+
+    def factor(key: tuple, h: float, cache: bool) -> tuple:
+        fk = (key, h)
+        if cache and fk in factor_cache:
+            return factor_cache[fk]
+        Ks, _, C = state(key)
+        n_fact[0] += 1
+        c, _lower = sla.cho_factor(Ks + (2.0 / h) * C + (4.0 / (h * h)) * Mr, lower=False, check_finite=False)
+        out = (c, (4.0 / h) * Mr + C)
+        if cache:
+            factor_cache[fk] = out
+        return out
+
+    Mchol, _ = sla.cho_factor(Mr, lower=False, check_finite=False)
+
+    def accel(key: tuple, u: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        Ks, fc, C = state(key)
+        return potrs(Mchol, amp(t) * fvec + fc - Ks @ u - C @ v, lower=0)[0]
+
+    def newmark(key, u0, v0, a0, t0, h, fac):
+        Ks, fc, C = state(key)
+        c, B = fac
+        rhs = amp(t0 + h) * fvec + fc - Ks @ u0 + B @ v0 + Mr @ a0
+        du = potrs(c, rhs, lower=0)[0]
+        return u0 + du, (2.0 / h) * du - v0, (4.0 / (h * h)) * du - (4.0 / h) * v0 - a0, du
+
+    def pen(u: np.ndarray, v: np.ndarray, i: int) -> tuple[float, float, float]:
+        d = float(cs[i] * u[cdof[i]] - cgap[i])
+        dd = float(cs[i] * v[cdof[i]])
+        return d, dd, ck[i] * d + cc[i] * dd
+
+    def h_switch(u: np.ndarray, v: np.ndarray, i: int, on: bool) -> float:
+        d, _, F = pen(u, v, i)
+        return F / ck[i] if on else min(d, F / ck[i])
+
+    u = np.zeros(nf)
+    v = np.zeros(nf)
+    if initial:
+        if "tip_displacement" in initial:
+            p = np.zeros(nf)
+            itip = model.reduced_index(2 * (model.n_nodes - 1))
+            p[itip] = 1.0
+            us = sla.solve(Kr, p, assume_a="pos")
+            u = us * (float(initial["tip_displacement"]) / us[itip])
+        else:
+            unknown = set(initial) - {"w", "w_x", "w_t", "w_xt"}
+            if unknown:
+                raise ValueError(f"unknown initial keys {sorted(unknown)}")
+            u = model.nodal_vector(initial.get("w"), initial.get("w_x"))[free]
+            v = model.nodal_vector(initial.get("w_t"), initial.get("w_xt"))[free]
+    key = tuple(h_switch(u, v, i, False) > 0 for i in range(nc))
+    a = accel(key, u, v, 0.0)
+
+    n_steps = int(round(t_end / dt))
+    nt = n_steps + 1
+    x_out = np.asarray(output_x, dtype=float)
+    P = model.interpolation_matrix(x_out)[:, free]
+    W = np.empty((nt, len(x_out)))
+    V = np.empty((nt, len(x_out)))
+    KE = np.empty(nt)
+    SE = np.empty(nt)
+    CE = np.empty(nt)
+    WORK = np.empty(nt)
+    DISS = np.empty(nt)
+    DASH = np.empty(nt)
+    EWORK = np.empty(nt)
+    FC = np.zeros((nt, nc))
+    PEN = np.zeros((nt, nc))
+    ENG = np.zeros((nt, nc), dtype=bool)
+    events: list = []
+    event_gap: list = []
+    event_state: list = []
+    acc = {"work": 0.0, "diss": 0.0, "dash": 0.0, "ework": 0.0}
+    ucols = np.asarray(cdof, dtype=int)
+
+    def store(k: int) -> None:
+        W[k] = P @ u
+        V[k] = P @ v
+        KE[k] = 0.5 * float(v @ (Mr @ v))
+        SE[k] = float(strain_energy(model, model.expand(u)))
+        d = cs * u[ucols] - cgap if nc else np.zeros(0)
+        dd = cs * v[ucols] if nc else np.zeros(0)
+        on = np.asarray(key, dtype=bool)
+        ENG[k] = on
+        PEN[k] = d
+        FC[k] = np.where(on, ck * d + cc * dd, 0.0)
+        CE[k] = 0.5 * float(np.sum(np.where(on, ck * d * d, 0.0)))
+        WORK[k], DISS[k], DASH[k], EWORK[k] = acc["work"], acc["diss"], acc["dash"], acc["ework"]
+
+    def account(du: np.ndarray, t_a: float, t_b: float, h: float) -> None:
+        acc["work"] += 0.5 * (amp(t_a) + amp(t_b)) * float(du @ fvec)
+        C = state(key)[2]
+        acc["diss"] += float(du @ (C @ du)) / h
+        on = np.asarray(key, dtype=bool)
+        if nc and on.any():
+            dq = du[ucols]
+            acc["dash"] += float(np.sum(np.where(on, cc * dq * dq, 0.0))) / h
+
+    store(0)
+    tiny = 1e-13
+    for n in range(n_steps):
+        t_grid_end = (n + 1) * dt
+        t = n * dt
+        rem = dt
+        toggled_at_t: set[int] = set()
+        guard = 0
+        while True:
+            guard += 1
+            if guard > 1000:
+                raise RuntimeError(f"too many switches in step {n}")
+            u1, v1, a1, du = newmark(key, u, v, a, t, rem, factor(key, rem, cache=(rem == dt)))
+            taus: dict[int, float] = {}
+            for i in range(nc):
+                on = key[i]
+                h1 = h_switch(u1, v1, i, on)
+                if not ((on and h1 <= 0.0) or (not on and h1 > 0.0)):
+                    continue
+                h0 = h_switch(u, v, i, on)
+                if (on and h0 <= 0.0) or (not on and h0 > 0.0):
+                    tau = 0.0
+                else:
+                    def hfun(hh, i=i, on=on, h0=h0):
+                        if hh <= 0.0:
+                            return h0
+                        uh, vh, _, _ = newmark(key, u, v, a, t, hh, factor(key, hh, cache=False))
+                        return h_switch(uh, vh, i, on)
+                    tau = brentq(hfun, 0.0, rem, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
+                if tau <= tiny and i in toggled_at_t:
+                    continue
+                taus[i] = tau
+            if not taus:
+                account(du, t, t + rem, rem)
+                u, v, a = u1, v1, a1
+                break
+            tau = min(taus.values())
+            switch = sorted(i for i, ti in taus.items() if ti <= tau + 1e-13)
+            if tau > tiny:
+                u1, v1, a1, du = newmark(key, u, v, a, t, tau, factor(key, tau, cache=False))
+                account(du, t, t + tau, tau)
+                u, v = u1, v1
+                t = t + tau
+                toggled_at_t = set()
+            newkey = list(key)
+            for i in switch:
+                d, dd, F_before = pen(u, v, i)
+                newkey[i] = not key[i]
+                F_after = ck[i] * d + cc[i] * dd if newkey[i] else 0.0
+                if not key[i]:
+                    F_before = 0.0
+                events.append((t, "impact" if newkey[i] else "rebound", i))
+                event_gap.append(-d)
+                event_state.append((d, dd, F_before, F_after))
+                toggled_at_t.add(i)
+                e = 0.5 * ck[i] * d * d
+                if newkey[i]:
+                    acc["ework"] += e
+                    acc["work"] += e
+                else:
+                    acc["dash"] += e
+                    acc["diss"] += e
+            key = tuple(newkey)
+            a = accel(key, u, v, t)
+            rem = t_grid_end - t
+            if rem <= tiny:
+                break
+        store(n + 1)
+
+    return DissipativeResult(
+        t=np.arange(nt) * dt, x_out=x_out, w=W, w_t=V, events=events, event_gap=event_gap,
+        contact_force=FC, engaged=ENG, kinetic=KE, strain=SE, contactor=CE, work=WORK, dissipated=DISS,
+        x_nodes=model.x.copy(), n_factorisations=n_fact[0], penetration=PEN, event_state=event_state,
+        dashpot=DASH, engagement_work=EWORK,
+    )
+
+
+# --------------------------------------------------------------------------
+# Exact-in-time integration of the FE model (for dashpots and damping models)
+# --------------------------------------------------------------------------
+@dataclass
+class ExactResult:
+    """Output of :func:`fe_transient_exact`.
+
+    ``t`` (n_t,) output grid ``k dt``; ``w``, ``w_t`` (n_t, n_points) at
+    ``x_out``; ``contact_force``, ``penetration`` (n_t, n_contactors) as in
+    :class:`DissipativeResult`; ``engaged`` (n_t, n_contactors);
+    ``events`` list of ``(time, 'impact'|'rebound', contactor)``;
+    ``event_state`` per event ``(d, d', force before, force after)``;
+    ``peaks`` list of ``(time, force, contactor)``: the largest contact force
+    of every contact interval, located exactly (Brent on ``dF/dt``, or the
+    interval's end when the force is largest there); ``kinetic``, ``strain``,
+    ``contactor`` energies on the grid; ``dashpot`` (n_t,) cumulative energy
+    dissipated by the dashpots (``c d'^2`` by the trapezoidal rule on the grid
+    and the exact sub-steps, plus ``1/2 k d^2`` at releases with ``d > 0``);
+    ``event_residual`` the largest ``|h|`` [m] of a switching function at a
+    located event (``F/k`` or ``min(d, F/k)``: round-off, ~1e-15 m).
+    """
+
+    t: np.ndarray
+    x_out: np.ndarray
+    w: np.ndarray
+    w_t: np.ndarray
+    contact_force: np.ndarray
+    penetration: np.ndarray
+    engaged: np.ndarray
+    events: list
+    event_state: list
+    peaks: list
+    kinetic: np.ndarray
+    strain: np.ndarray
+    contactor: np.ndarray
+    dashpot: np.ndarray
+    event_residual: float
+    n_modes_fe: int
+
+
+def _load_pieces(load: dict, t_end: float) -> list[tuple[float, float, float, float, float]]:
+    """``(t0, t1, const, amp, Omega)``: the load ``const + amp sin(Omega (t - t0))`` on [t0, t1)."""
+    kind = load.get("kind", "none")
+    if kind in ("none", None):
+        return [(0.0, math.inf, 0.0, 0.0, 0.0)]
+    shape = load.get("shape", "half_sine" if kind == "base_acceleration" else "step")
+    A, start = float(load["amplitude"]), float(load.get("start", 0.0))
+    pieces = [(0.0, start, 0.0, 0.0, 0.0)] if start > 0 else []
+    if shape == "step":
+        pieces.append((start, math.inf, A, 0.0, 0.0))
+    elif shape == "half_sine":
+        T = float(load["duration"])
+        pieces += [(start, start + T, 0.0, A, math.pi / T), (start + T, math.inf, 0.0, 0.0, 0.0)]
+    else:
+        raise ValueError(f"fe_transient_exact: load shape {shape!r} not supported (step, half_sine)")
+    return [p for p in pieces if p[1] > p[0]]
+
+
+def fe_transient_exact(
+    length: float,
+    EI: float,
+    rhoA: float,
+    *,
+    left: tuple[float, float],
+    right: tuple[float, float],
+    contactors: Sequence[dict] = (),
+    load: dict | None = None,
+    initial: dict | None = None,
+    damping: dict | None = None,
+    dt: float,
+    t_end: float,
+    output_x: Sequence[float] | None = None,
+    n_elements: int = 50,
+    **structure: Sequence,
+) -> ExactResult:
+    """The FE model of :func:`fe_transient_dissipative` integrated EXACTLY in time between events.
+
+    Same parameters (``load``: step or half-sine). The only approximation
+    left is the spatial discretisation (Hermite cubics), so the reference
+    converges by refining the mesh alone, and the fast components a dashpot
+    force jump excites are integrated exactly (an average-acceleration step
+    keeps them with wrong phases, which moves a dashpot's release time by
+    microseconds).
+
+    Method
+    ------
+    In the free state's FE modes ``u = Phi q`` (``Phi^T M Phi = I``) and the
+    scaled state ``z = (S q, q', 1, s, c)`` with ``S = diag(sqrt(omega^2 +
+    omega_1^2))`` (so ``|A| ~ omega_max``: a well-scaled matrix exponential),
+    each state (engaged set) and load piece is the autonomous linear system
+    ``z' = A z``: ``q'' = -K_s q - C_s q' + f_c + (const + amp s) f``, ``s' =
+    Omega c``, ``c' = -Omega s`` (``s, c`` the sine and cosine of the load's
+    phase). The grid steps are ``z <- expm(A dt) z`` (one exponential per
+    state and piece, cached). A switching function (as in
+    :func:`fe_transient_dissipative`) that changes sign over a step is located
+    by Brent's method (xtol 1e-15 s) on ``z(tau) = V exp(Lambda tau) V^-1 z``
+    (eigen-decomposition of ``A``), and the state at the root is
+    ``expm(A tau) z``; ``event_residual`` reports the switching function there.
+    Two crossings inside one grid step are not seen (choose ``dt`` below the
+    shortest contact or separation).
+    """
+    contactors = [dict(c) for c in contactors]
+    cs = np.array([1.0 if c["side"] == "above" else -1.0 for c in contactors])
+    for c in contactors:
+        if c.get("side") not in ("above", "below") or not (0 < c["stiffness"] < math.inf) or c["gap"] < 0:
+            raise ValueError(f"bad contactor {c}")
+    spec = dict(damping) if damping else {"model": "modal"}
+    load = dict(load) if load else {"kind": "none"}
+    kind = load.get("kind", "none")
+    if output_x is None:
+        output_x = [c["position"] for c in contactors] + [length]
+    extra = [c["position"] for c in contactors] + ([load["position"]] if kind == "point_force" else [])
+    model = assemble(length, EI, rhoA, n_elements=n_elements, left=left, right=right, nodes_at=extra, **structure)
+    free = model.free
+    nf = len(free)
+    lam, Phi = sla.eigh(model.K_r, model.M_r)
+    lam = np.where(lam < 1e-10 * model.EI / (model.rhoA * length**4), 0.0, lam)
+    om2_ref = max(float(lam[lam > 0][0]) if np.any(lam > 0) else 0.0, model.EI / (model.rhoA * length**4))
+    S = np.sqrt(lam + om2_ref)
+    cdof = [model.reduced_index(2 * model.node_index(c["position"])) for c in contactors]
+    phc = Phi[cdof, :] if contactors else np.zeros((0, nf))  # (nc, nf)
+    ck = np.array([float(c["stiffness"]) for c in contactors])
+    cc = np.array([float(c.get("damping", 0.0)) for c in contactors])
+    cgap = np.array([float(c["gap"]) for c in contactors])
+    nc = len(contactors)
+    fvec = np.zeros(nf)
+    if kind == "base_acceleration":
+        r = np.zeros(model.n_dof)
+        r[0::2] = 1.0
+        fvec = -(model.M @ r)[free]
+    elif kind == "point_force":
+        fvec[model.reduced_index(2 * model.node_index(load["position"]))] = 1.0
+    fq = Phi.T @ fvec
+    pieces = _load_pieces(load, t_end)
+    C_free: list = []
+    n = 2 * nf + 3
+    cache_A: dict = {}
+    cache_P: dict = {}
+    cache_E: dict = {}
+
+    def system(key: tuple, ip: int) -> np.ndarray:
+        if (key, ip) not in cache_A:
+            Ks = np.diag(lam).astype(float)
+            K_phys = model.K_r.copy()
+            for i in range(nc):
+                if key[i]:
+                    K_phys[cdof[i], cdof[i]] += ck[i]
+            Cs = Phi.T @ _beam_damping(model, spec, K_phys, any(key), C_free) @ Phi
+            fc = np.zeros(nf)
+            for i in range(nc):
+                if key[i]:
+                    Ks += ck[i] * np.outer(phc[i], phc[i])
+                    Cs += cc[i] * np.outer(phc[i], phc[i])
+                    fc += cs[i] * ck[i] * cgap[i] * phc[i]
+            _, _, const, amp, Om = pieces[ip]
+            A = np.zeros((n, n))
+            A[:nf, nf:2 * nf] = np.diag(S)
+            A[nf:2 * nf, :nf] = -Ks / S[None, :]
+            A[nf:2 * nf, nf:2 * nf] = -0.5 * (Cs + Cs.T)
+            A[nf:2 * nf, 2 * nf] = fc + const * fq
+            A[nf:2 * nf, 2 * nf + 1] = amp * fq
+            A[2 * nf + 1, 2 * nf + 2] = Om
+            A[2 * nf + 2, 2 * nf + 1] = -Om
+            cache_A[(key, ip)] = A
+        return cache_A[(key, ip)]
+
+    def prop(key: tuple, ip: int, h: float, cache: bool) -> np.ndarray:
+        if cache and (key, ip, h) in cache_P:
+            return cache_P[(key, ip, h)]
+        P = sla.expm(system(key, ip) * h)
+        if cache:
+            cache_P[(key, ip, h)] = P
+        return P
+
+    def eig(key: tuple, ip: int):
+        if (key, ip) not in cache_E:
+            ev, V = np.linalg.eig(system(key, ip))
+            cache_E[(key, ip)] = (ev, V, np.linalg.inv(V))
+        return cache_E[(key, ip)]
+
+    def contact(z: np.ndarray, i: int, zdot: np.ndarray | None = None) -> tuple[float, float, float, float]:
+        """(d, d', F, dF/dt) of contactor i in state z."""
+        q = z[:nf] / S
+        d = float(cs[i] * phc[i] @ q - cgap[i])
+        dd = float(cs[i] * phc[i] @ z[nf:2 * nf])
+        ddd = float(cs[i] * phc[i] @ zdot[nf:2 * nf]) if zdot is not None else 0.0
+        return d, dd, ck[i] * d + cc[i] * dd, ck[i] * dd + cc[i] * ddd
+
+    def hsw(z: np.ndarray, i: int, on: bool) -> float:
+        d, _, F, _ = contact(z, i)
+        return F / ck[i] if on else min(d, F / ck[i])
+
+    # initial state
+    q0 = np.zeros(nf)
+    v0 = np.zeros(nf)
+    if initial:
+        if "tip_displacement" in initial:
+            p = np.zeros(nf)
+            itip = model.reduced_index(2 * (model.n_nodes - 1))
+            p[itip] = 1.0
+            us = sla.solve(model.K_r, p, assume_a="pos")
+            q0 = Phi.T @ (model.M_r @ (us * (float(initial["tip_displacement"]) / us[itip])))
+        else:
+            q0 = Phi.T @ (model.M_r @ model.nodal_vector(initial.get("w"), initial.get("w_x"))[free])
+            v0 = Phi.T @ (model.M_r @ model.nodal_vector(initial.get("w_t"), initial.get("w_xt"))[free])
+
+    def piece_at(t: float) -> int:
+        for j, p in enumerate(pieces):
+            if p[0] <= t < p[1]:
+                return j
+        return len(pieces) - 1
+
+    def enter_piece(z: np.ndarray, ip: int, t: float) -> np.ndarray:
+        z = z.copy()
+        z[2 * nf] = 1.0
+        Om, t0 = pieces[ip][4], pieces[ip][0]
+        z[2 * nf + 1], z[2 * nf + 2] = math.sin(Om * (t - t0)), math.cos(Om * (t - t0))
+        return z
+
+    z = np.concatenate([S * q0, v0, [1.0, 0.0, 1.0]])
+    ip = piece_at(0.0)
+    z = enter_piece(z, ip, 0.0)
+    key = tuple(hsw(z, i, False) > 0 for i in range(nc))
+
+    n_steps = int(round(t_end / dt))
+    nt = n_steps + 1
+    x_out = np.asarray(output_x, dtype=float)
+    Pout = model.interpolation_matrix(x_out)[:, free] @ Phi
+    W = np.empty((nt, len(x_out)))
+    Vv = np.empty((nt, len(x_out)))
+    KE, SE, CE, DASH = (np.empty(nt) for _ in range(4))
+    FC = np.zeros((nt, nc))
+    PEN = np.zeros((nt, nc))
+    ENG = np.zeros((nt, nc), dtype=bool)
+    events, event_state, peaks = [], [], []
+    resid = 0.0
+    dash = [0.0]
+    open_peak: dict[int, tuple[float, float]] = {}
+
+    def advance(z0: np.ndarray, h: float, cache: bool) -> np.ndarray:
+        return prop(key, ip, h, cache) @ z0
+
+    def z_at(z0: np.ndarray, tau: float) -> np.ndarray:
+        ev, V, Vi = eig(key, ip)
+        return np.real(V @ (np.exp(ev * tau) * (Vi @ z0)))
+
+    def kinematics(Z: np.ndarray, AZ: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+        """(d, d', F, dF/dt) of every contactor at every row of Z: (m, nc) each."""
+        d = cs * ((Z[:, :nf] / S) @ phc.T) - cgap
+        dd = cs * (Z[:, nf:2 * nf] @ phc.T)
+        ddd = cs * (AZ[:, nf:2 * nf] @ phc.T) if AZ is not None else np.zeros_like(dd)
+        return d, dd, ck * d + cc * dd, ck * dd + cc * ddd
+
+    def first_switch(Z: np.ndarray) -> int:
+        """Index of the first row where a contactor's switching condition holds (len(Z) if none)."""
+        if nc == 0:
+            return len(Z)
+        d, _, F, _ = kinematics(Z)
+        on = np.asarray(key, dtype=bool)
+        bad = np.where(on, F / ck <= 0.0, np.minimum(d, F / ck) > 0.0).any(axis=1)
+        return int(np.argmax(bad)) if bad.any() else len(Z)
+
+    def accept(k0: int, z0: np.ndarray, Z: np.ndarray, t0: float, h: float) -> None:
+        """Book the states ``Z`` (rows at ``t0 + (j + 1) h``) reached from ``z0``: outputs from grid index ``k0``."""
+        Zall = np.vstack([z0[None, :], Z])
+        on = np.asarray(key, dtype=bool)
+        if nc and on.any():
+            A = system(key, ip)
+            d, dd, F, Fd = kinematics(Zall, Zall @ A.T)
+            rate = np.sum(np.where(on, cc * dd * dd, 0.0), axis=1)
+            inc = np.cumsum(0.5 * h * (rate[:-1] + rate[1:]))
+            for i in np.flatnonzero(on):
+                best = open_peak.get(i, (t0, -math.inf))
+                j = int(np.argmax(F[:, i]))
+                if F[j, i] > best[1]:
+                    best = (t0 + j * h, float(F[j, i]))
+                near = [jj for jj in (j - 1, j) if 0 <= jj < len(Zall) - 1]  # the maximum's neighbourhood only
+                for j in [jj for jj in near if Fd[jj, i] > 0.0 >= Fd[jj + 1, i]]:
+                    zj = Zall[j]
+                    g = lambda tau, i=i, zj=zj: kinematics(z_at(zj, tau)[None], (A @ z_at(zj, tau))[None])[3][0, i]
+                    tau = brentq(g, 0.0, h, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+                    FF = float(kinematics(z_at(zj, tau)[None])[2][0, i])
+                    if FF > best[1]:
+                        best = (t0 + j * h + tau, FF)
+                open_peak[i] = best
+        else:
+            d, dd, F, _ = kinematics(Zall)
+            inc = np.zeros(len(Z))
+        if k0 < 0:  # a sub-step: no grid output
+            dash[0] += float(inc[-1]) if len(inc) else 0.0
+            return
+        m = len(Z)
+        Q = Z[:, :nf] / S
+        W[k0:k0 + m] = Q @ Pout.T
+        Vv[k0:k0 + m] = Z[:, nf:2 * nf] @ Pout.T
+        KE[k0:k0 + m] = 0.5 * np.sum(Z[:, nf:2 * nf] ** 2, axis=1)
+        SE[k0:k0 + m] = 0.5 * (Q * Q) @ lam
+        if nc:
+            PEN[k0:k0 + m] = d[1:]
+            ENG[k0:k0 + m] = on
+            FC[k0:k0 + m] = np.where(on, F[1:], 0.0)
+            CE[k0:k0 + m] = 0.5 * np.sum(np.where(on, ck * d[1:] ** 2, 0.0), axis=1)
+        DASH[k0:k0 + m] = dash[0] + inc
+        dash[0] += float(inc[-1]) if m else 0.0
+
+    accept(0, z, np.zeros((0, n)), 0.0, dt)
+    zero = z[None, :]
+    Q0 = z[:nf] / S
+    W[0], Vv[0], KE[0], SE[0] = Pout @ Q0, Pout @ z[nf:2 * nf], 0.5 * z[nf:2 * nf] @ z[nf:2 * nf], 0.5 * lam @ Q0**2
+    if nc:
+        d0, _, F0, _ = kinematics(zero)
+        PEN[0], ENG[0], FC[0] = d0[0], key, np.where(key, F0[0], 0.0)
+        CE[0] = 0.5 * float(np.sum(np.where(key, ck * d0[0] ** 2, 0.0)))
+    DASH[0] = 0.0
+    block = 512
+    k, t = 0, 0.0
+    while k < n_steps:
+        if t >= pieces[ip][1] - 1e-9 * dt and ip + 1 < len(pieces):
+            ip += 1
+            z = enter_piece(z, ip, t)
+        room = pieces[ip][1] - t
+        m = min(block, n_steps - k, int(math.floor(room / dt + 1e-9)) if math.isfinite(room) else block)
+        if m >= 1:
+            P = prop(key, ip, dt, True)
+            Z = np.empty((m, n))
+            zz = z
+            for j in range(m):
+                zz = P @ zz
+                Z[j] = zz
+            jb = first_switch(Z)
+            if jb:
+                accept(k + 1, z, Z[:jb], t, dt)
+                z = Z[jb - 1]
+                k += jb
+                t = k * dt
+            if jb == m:
+                continue
+        # one grid step with its events (or a load piece ending inside it)
+        t_grid = (k + 1) * dt
+        guard = 0
+        toggled: set[int] = set()
+        while t < t_grid - 1e-9 * dt:
+            guard += 1
+            if guard > 1000:
+                raise RuntimeError(f"too many switches near t = {t}")
+            if t >= pieces[ip][1] - 1e-9 * dt and ip + 1 < len(pieces):
+                ip += 1
+                z = enter_piece(z, ip, t)
+            t_stop = min(t_grid, pieces[ip][1])
+            h = t_stop - t
+            z1 = advance(z, h, False)
+            taus = {}
+            for i in range(nc):
+                on = key[i]
+                h1 = hsw(z1, i, on)
+                if not ((on and h1 <= 0.0) or (not on and h1 > 0.0)):
+                    continue
+                h0 = hsw(z, i, on)
+                if (on and h0 <= 0.0) or (not on and h0 > 0.0):
+                    tau = 0.0
+                else:
+                    f = lambda tau, i=i, on=on, h0=h0: h0 if tau <= 0.0 else hsw(z_at(z, tau), i, on)
+                    tau = brentq(f, 0.0, h, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+                if tau <= 1e-14 and i in toggled:
+                    continue
+                taus[i] = tau
+            if not taus:
+                accept(-1, z, z1[None, :], t, h)
+                z, t = z1, t_stop
+                continue
+            tau = min(taus.values())
+            switch = sorted(i for i, ti in taus.items() if ti <= tau + 1e-14)
+            if tau > 1e-14:
+                z1 = advance(z, tau, False)
+                accept(-1, z, z1[None, :], t, tau)
+                z, t = z1, t + tau
+                toggled = set()
+            newkey = list(key)
+            for i in switch:
+                d, dd, F, _ = contact(z, i)
+                resid = max(resid, abs(hsw(z, i, key[i])))
+                newkey[i] = not key[i]
+                events.append((t, "impact" if newkey[i] else "rebound", i))
+                event_state.append((d, dd, F if key[i] else 0.0, F if newkey[i] else 0.0))
+                toggled.add(i)
+                if key[i]:
+                    dash[0] += 0.5 * ck[i] * d * d
+                    tp, Fp = open_peak.pop(i)
+                    peaks.append((tp, Fp, i))
+                else:
+                    open_peak[i] = (t, F)
+            key = tuple(newkey)
+        k += 1
+        t = k * dt
+        accept(k, z, np.zeros((0, n)), t, dt)
+        Qk = z[:nf] / S
+        W[k], Vv[k], KE[k], SE[k] = Pout @ Qk, Pout @ z[nf:2 * nf], 0.5 * z[nf:2 * nf] @ z[nf:2 * nf], 0.5 * lam @ Qk**2
+        if nc:
+            dk, _, Fk, _ = kinematics(z[None, :])
+            PEN[k], ENG[k], FC[k] = dk[0], key, np.where(key, Fk[0], 0.0)
+            CE[k] = 0.5 * float(np.sum(np.where(key, ck * dk[0] ** 2, 0.0)))
+        DASH[k] = dash[0]
+    for i, (tp, Fp) in open_peak.items():
+        peaks.append((tp, Fp, i))
+    peaks.sort()
+    return ExactResult(
+        t=np.arange(nt) * dt, x_out=x_out, w=W, w_t=Vv, contact_force=FC, penetration=PEN, engaged=ENG,
+        events=events, event_state=event_state, peaks=peaks, kinetic=KE, strain=SE, contactor=CE, dashpot=DASH,
+        event_residual=resid, n_modes_fe=nf,
     )

@@ -140,6 +140,7 @@ MAY_IMPORT: dict[str, set[str]] = {
     "fit": {"model", "scenario", "modal", "solver", "result", "plot", "simulation", "experiment"},
     "explore": {"model", "scenario", "modal", "solver", "result", "plot", "simulation"},
     "paper": {"model", "scenario", "modal", "solver", "result", "plot", "simulation", "experiment"},
+    "validation": {"model", "scenario", "modal", "solver", "result", "plot", "simulation", "paper"},
 }
 
 

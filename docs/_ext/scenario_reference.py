@@ -39,13 +39,16 @@ MEANING: dict[str, str] = {
     "contactors[].stiffness": "Contact spring stiffness k [N/m], acting only while engaged.",
     "contactors[].gap": "Clearance c [m] between the beam at rest and the contactor surface.",
     "contactors[].side": "Where the contactor is: `below` pushes while w(a) < -gap, `above` while w(a) > gap.",
-    "contactors[].damping": "Dashpot c [N s/m] in parallel with the spring: force k d + c d' while positive (never pulls).",
-    "contactors[].restitution": "Coefficient of restitution 0 < e <= 1 instead of `damping` (see the dissipation page).",
-    "damping.model": "`modal` (per-state ratios, the paper), `free_modes` (the free state's ratios kept in every state) or `rayleigh`.",
-    "damping.free": "Modal damping ratio xi_n of the free state (paper eq. 9): one value or one per mode (`modal`, `free_modes`).",
-    "damping.contact": "Modal damping ratio of states with a contactor engaged: one value or one per mode (`modal`).",
-    "damping.alpha": "Rayleigh mass coefficient alpha [1/s]: C = alpha M + beta K (`rayleigh`).",
-    "damping.beta": "Rayleigh stiffness coefficient beta [s] (`rayleigh`).",
+    "damping.model": "`modal` (default: each state damps its own modes, ratios `free` and `contact`), "
+                     "`free_modes` (the free state's ratios `free` as one damping matrix kept in every state) or "
+                     "`rayleigh` (C = alpha M + beta K of each state); keys of another model are refused.",
+    "damping.alpha": "Rayleigh mass-proportional coefficient alpha [1/s] (`model = \"rayleigh\"`).",
+    "damping.beta": "Rayleigh stiffness-proportional coefficient beta [s] (`model = \"rayleigh\"`).",
+    "contactors[].damping": "Dashpot c [N s/m] in parallel with the spring: force k d + c d' while the penetration "
+                            "d > 0 and that force is positive (it never pulls).",
+    "contactors[].restitution": "Coefficient of restitution 0 < e <= 1 instead of `damping`.",
+    "damping.free": "Modal damping ratio xi_n of the free state (paper eq. 9): one value or one per mode.",
+    "damping.contact": "Modal damping ratio of states with a contactor engaged: one value or one per mode.",
     "excitation.kind": "What the load is.",
     "excitation.shape": "Time history: half-sine pulse, step, harmonic, a table from `file`, or random (from `psd`).",
     "excitation.amplitude": "Peak value: [m/s^2] (or g) for base acceleration, [N] point force, [N/m] distributed.",
@@ -79,6 +82,25 @@ MEANING: dict[str, str] = {
     "initial.position": "Where the initial static deflection is imposed [m] (default the tip).",
     "initial.modal_displacement": "Initial modal coordinates eta_n(0) of the free state (list).",
     "initial.modal_velocity": "Initial modal velocities d eta_n/dt (0) of the free state (list).",
+    "initial.velocity": "Uniform initial velocity [m/s] (a translation), or a velocity field along the beam as rows "
+                        '`[[x, v], ...]` (units in strings: `[["0 m", "0 m/s"], ["0.78 m", "-3 m/s"]]`), linear '
+                        "between rows, spanning 0 .. L. Projected on the run's modes (see below).",
+    "initial.velocity_file": "The velocity field from a two-column file `position, velocity` (unit headers such as "
+                             "`x [mm],v [mm/s]`), relative to the scenario file.",
+    "initial.displacement": "Initial deflection along the beam as rows `[[x, w], ...]` [m], linear between rows, "
+                            "spanning 0 .. L.",
+    "initial.displacement_file": "The deflection field from a two-column file `position, displacement`.",
+    "initial.angular_velocity": "Rigid rotation [rad/s] about `pivot`: w_t(x, 0) = angular_velocity (x - pivot) "
+                                "(positive turns +x toward +w); adds to `velocity`.",
+    "initial.pivot": "Axis of the rigid rotation [m] (on the beam; required with `angular_velocity`).",
+    "initial.equilibrium": "`true`: start from the static equilibrium under `[preload]`, with the contactors it "
+                           "engages (exact static contact problem of the run's model).",
+    "preload.kind": "Constant load during the whole run: `gravity` (the acceleration of gravity along +w: `\"-1 g\"` "
+                    "when w points up), `base_acceleration` (the base's acceleration, as in `[excitation]`: gravity "
+                    "toward -w is `\"1 g\"`), or `point_force`.",
+    "preload.amplitude": "[m/s^2] (or g) for gravity and base acceleration, [N] for a point force; along +w.",
+    "preload.position": "Point of application of a point force [m].",
+    "preload.position_ratio": "The same as a fraction of L.",
     "solver.modes": "Modes per state N (paper: 8), or `auto`: add modes until the metrics change by less than `solver.tolerance`.",
     "solver.time_step": "Output sampling interval [s]; events, extrema and metrics do not depend on it.",
     "solver.end_time": "Simulated duration [s].",
@@ -122,6 +144,8 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "excitation.kind": S._KINDS,
     "excitation.shape": S._SHAPES,
     "excitation.hold": S._HOLDS,
+    "preload.kind": S._PRELOAD_KINDS,
+    "damping.model": DAMPING_MODELS,
     "contactors[].side": S._SIDES,
     "damping.model": DAMPING_MODELS,
     "output.fields": S.OUTPUT_FIELDS,
@@ -165,6 +189,8 @@ def _kind(node: Any) -> str:
         return "preset name or table" if node.preset_ok else "table"
     if isinstance(node, S._Array):
         return "array of tables"
+    if node.rows:
+        return "rows [x, value]" if node.list_only else "value or rows [x, value]"
     if node.list_only:
         return "list"
     return "value or list" if node.list_ok else "value"
@@ -206,11 +232,52 @@ def render() -> str:
         if top in _ARRAYS:
             title = f"`[[{top}]]`"
         lines += [f"## {title}", "", "| key | kind | meaning | allowed |", "|---|---|---|---|", *rows, ""]
+    lines += _initial_section()
     lines += ["", "## Support presets", "", "| preset | translational [N/m] | rotational [N m/rad] |", "|---|---|---|"]
     for name, (k, kt) in SUPPORT_PRESETS.items():
         lines.append(f"| `{name}` | {k:g} | {kt:g} |")
     lines += ["", "## Example", "", "```{literalinclude} ../../examples/case03.toml", ":language: toml", "```", ""]
     return "\n".join(lines)
+
+
+def _initial_section() -> list[str]:
+    """Prose on initial states and the preload (the rule of :mod:`impactbeam.solver.initial`)."""
+    from impactbeam.solver.initial import RESIDUAL_WARNING
+
+    return [
+        "## Initial states and preload",
+        "",
+        "Every initial field (`tip_displacement`'s static shape, the `displacement` and `velocity` rows or files,",
+        "the uniform `velocity`, the rigid rotation `angular_velocity` about `pivot`) is projected onto the run's",
+        "free-state basis (the paper's modes or the shared Ritz basis of `solver.basis`) in the kinetic inner",
+        "product of the model: rho A(x), the point masses' mass and rotary inertia, and rho I for a Timoshenko",
+        "beam. The modes are mass-orthonormal, so this is the best approximation of the field in that norm; when",
+        f"it misses more than {100 * RESIDUAL_WARNING:g} % of the field (relative kinetic-norm residual: motion the supports",
+        "forbid, such as a uniform velocity of a clamped beam, or detail finer than the modes) a warning gives",
+        "the residual. A rigid rotation of a beam whose supports allow it (pinned-free) is represented exactly.",
+        "Displacements and velocities from several keys add up; a uniform `velocity` and `angular_velocity`",
+        "together are any rigid motion.",
+        "",
+        "`[preload]` is a constant load acting during the whole run. With `initial.equilibrium = true` the run",
+        "starts from the static equilibrium of its own model under it, with the contactors it engages: the",
+        "static contact problem (one-sided springs with their gaps) is solved exactly, as a linear",
+        "complementarity problem, and compared with the exact static solution of the continuum (a warning",
+        "gives the difference when it exceeds the same fraction). A beam that nothing holds against the preload",
+        "(free-free under gravity with no stop under it) is refused. Gravity pulling toward -w (w up) is",
+        '`kind = "gravity"`, `amplitude = "-1 g"`, or equivalently `kind = "base_acceleration"`,',
+        '`amplitude = "1 g"` (the base accelerating upward), the convention of `[excitation]`.',
+        "",
+        "```toml",
+        "[initial]                      # a pinned beam swung about its pin (code_aster SDNL32)",
+        'angular_velocity = "-3.8 rad/s"',
+        "pivot = 0.0",
+        "",
+        "[preload]                      # or: a tube resting on its support under gravity",
+        'kind = "gravity"',
+        'amplitude = "-1 g"',
+        "```",
+        "",
+    ]
 
 
 def _write(app: Any) -> None:

@@ -340,11 +340,14 @@ def numeric_columns(
     columns: Sequence[int],
     scales: Sequence[float],
     fail: Callable[[str], Exception],
+    abscissa: tuple[str, str] = ("time", "s"),
 ) -> tuple[list[np.ndarray], list[int]]:
-    """Numbers of some columns in SI; the first of ``columns`` is time.
+    """Numbers of some columns in SI; the first of ``columns`` is time (or ``abscissa``).
 
     Each cell is checked (a number, finite) and multiplied by its column's
-    factor in decimal arithmetic; times must increase strictly.
+    factor in decimal arithmetic; times must increase strictly. ``abscissa``
+    names the first column's quantity and SI unit in messages (``("position",
+    "m")`` for a field along the beam).
 
     Returns
     -------
@@ -355,7 +358,8 @@ def numeric_columns(
     """
     ncol = table.ncol
     names = table.names
-    unit = table.units[columns[0]] or "s"
+    noun, si_unit = abscissa
+    unit = table.units[columns[0]] or si_unit
     out: list[list[float]] = [[] for _ in columns]
     line_numbers: list[int] = []
     for n, row in table.rows:
@@ -376,8 +380,8 @@ def numeric_columns(
             value = x if scale == 1.0 else scale_decimal(cell, scale)
             if k == 0 and out[0] and not value > out[0][-1]:
                 raise fail(
-                    f"line {n}, column {j + 1} ({names[j]}): time {x:g} {unit} does not come after the "
-                    f"previous {out[0][-1] / scale:g} {unit} (times must increase strictly)"
+                    f"line {n}, column {j + 1} ({names[j]}): {noun} {x:g} {unit} does not come after the "
+                    f"previous {out[0][-1] / scale:g} {unit} ({noun}s must increase strictly)"
                 )
             out[k].append(value)
         line_numbers.append(n)

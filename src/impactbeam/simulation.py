@@ -261,6 +261,8 @@ def simulate(
     are also listed in ``result.warnings``.
     """
     _require_scenario(scenario)
+    if scenario.preload is not None:
+        raise ParameterError("preload: not supported by this version of the solver")
     res = simulate_system(
         scenario.beam,
         scenario.contactors,

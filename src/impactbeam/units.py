@@ -75,6 +75,8 @@ DIMENSIONS: dict[str, _Dimension] = {
     "acceleration_psd": _Dimension("(m/s^2)^2/Hz", "m**2/s**4/Hz", "an acceleration spectral density"),
     "force_psd": _Dimension("N^2/Hz", "N**2/Hz", "a force spectral density"),
     "force_per_length_psd": _Dimension("(N/m)^2/Hz", "N**2/m**2/Hz", "a spectral density of force per length"),
+    "velocity": _Dimension("m/s", "m/s", "a velocity"),
+    "angular_velocity": _Dimension("rad/s", "rad/s", "an angular velocity"),
     "dimensionless": _Dimension("", "dimensionless", "a dimensionless number"),
 }
 

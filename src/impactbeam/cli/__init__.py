@@ -26,6 +26,7 @@ from . import (
     cmd_reproduce,
     cmd_simulate,
     cmd_sweep,
+    cmd_validate,
 )
 from ._group import Interrupted, fail, handle_errors, load_with_overrides, main, take_warnings, warning_lines
 
@@ -46,5 +47,6 @@ for _command in (
     cmd_random.random_command,
     cmd_explore.explore,
     cmd_info.info,
+    cmd_validate.validate,
 ):
     main.add_command(_command)

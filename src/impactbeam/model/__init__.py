@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from .beam import SUPPORT_PRESETS, Beam, Contactor, InteriorSpring, PointMass, Section, Support
 from .damping import Damping
-from .loading import Excitation, InitialCondition
+from .loading import Excitation, InitialCondition, Preload, Profile
 from .options import BASES, MAX_MODES, SolverOptions
 
 __all__ = [
@@ -28,6 +28,8 @@ __all__ = [
     "SUPPORT_PRESETS",
     "Excitation",
     "InitialCondition",
+    "Preload",
+    "Profile",
     "Damping",
     "SolverOptions",
     "BASES",

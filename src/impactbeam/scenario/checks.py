@@ -170,8 +170,11 @@ def _si_unit(key: str, raw: Mapping[str, Any]) -> str | None:
     """The SI unit a unit-less number at ``key`` is read in; None for pure numbers and words."""
     excitation = raw.get("excitation")
     kind = excitation.get("kind") if isinstance(excitation, Mapping) else None
+    preload = raw.get("preload")
+    preload_kind = preload.get("kind") if isinstance(preload, Mapping) else None
     try:
-        dimension = path_dimension(key, kind if isinstance(kind, str) else None)
+        dimension = path_dimension(key, kind if isinstance(kind, str) else None,
+                                   preload_kind if isinstance(preload_kind, str) else None)
     except ScenarioError:
         return None
     if dimension is None and key == "excitation.amplitude":

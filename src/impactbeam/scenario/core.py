@@ -13,7 +13,7 @@ from typing import Any
 from .._warnings import emit_user_level_warning
 from ..model.beam import Beam, Contactor
 from ..exceptions import ScenarioError
-from ..model.loading import Excitation, InitialCondition
+from ..model.loading import Excitation, InitialCondition, Preload
 from ..model.fatigue import FatigueSpec
 from ..model import Damping, SolverOptions
 from .edit import _normalise, scenario_toml, set_path
@@ -26,6 +26,7 @@ from .parse_run import (
     _parse_initial,
     _parse_output,
     _parse_output_fields,
+    _parse_preload,
     _parse_solver,
 )
 from .parse_structure import _parse_beam, _parse_contactors
@@ -64,6 +65,9 @@ class Scenario:
         ``stress`` (which also adds its maximum to the metrics).
     fatigue : FatigueSpec or None
         ``[fatigue]``: the points and S-N curve of the fatigue statistics.
+    preload : Preload or None
+        The constant load of ``[preload]`` (acting during the whole run; the
+        load of ``initial.equilibrium``).
     """
 
     beam: Beam
@@ -79,6 +83,7 @@ class Scenario:
     name: str = "scenario"
     output_fields: tuple[str, ...] = ()
     fatigue: FatigueSpec | None = None
+    preload: Preload | None = None
 
     def to_toml(self) -> str:
         """The scenario as TOML text (``load_scenario`` of it gives the same scenario)."""
@@ -164,7 +169,8 @@ def parse_scenario(
     contactors = _parse_contactors(raw, beam)
     damping = _parse_damping(raw)
     excitation = _parse_excitation(raw, beam, base)
-    initial = _parse_initial(raw, beam)
+    initial = _parse_initial(raw, beam, base)
+    preload = _parse_preload(raw, beam)
     solver = _parse_solver(raw)
     points = _parse_output(raw, beam, contactors)
     scenario = Scenario(
@@ -181,6 +187,7 @@ def parse_scenario(
         name=name,
         output_fields=_parse_output_fields(raw),
         fatigue=_parse_fatigue(raw, beam),
+        preload=preload,
     )
     warn_unusual(scenario)
     return scenario

@@ -7,9 +7,11 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..model.beam import Beam, Contactor
 from ..exceptions import ScenarioError
-from ..model.loading import Excitation, InitialCondition
+from ..model.loading import Excitation, InitialCondition, Preload, Profile
 from ..model.fatigue import FatigueSpec
 from ..model.psd import PowerSpectralDensity
 from ..model import BASES, Damping, SolverOptions
@@ -32,12 +34,14 @@ from .schema import (
     EXCITATION_DIMENSIONS,
     OUTPUT_FIELD_ALIASES,
     OUTPUT_FIELDS,
+    PRELOAD_DIMENSIONS,
     PSD_DIMENSIONS,
     _HOLDS,
     _KINDS,
     _MEAN_STRESS,
     _SHAPES,
     _join,
+    describe_value,
 )
 from .traces import read_table
 
@@ -109,10 +113,7 @@ def _parse_excitation(raw: Mapping[str, Any], beam: Beam, base_dir: Path | None)
                 key="excitation.amplitude",
             )
         _required(ex, "excitation", "file", ' for shape = "table"')
-        file = _string("excitation.file", ex["file"])
-        path = Path(file).expanduser()
-        if not path.is_absolute() and base_dir is not None:
-            path = Path(base_dir) / path
+        path, file = _file_path(ex["file"], "excitation.file", base_dir)
         times, values = read_table(path, value_dimension=dimension, key="excitation.file", label=file)
         hold = _choice("excitation.hold", ex.get("hold", "constant"), _HOLDS)
     else:
@@ -237,7 +238,37 @@ def _float_list(key: str, value: list[Any]) -> tuple[float, ...]:
     return tuple(to_si(v, "dimensionless", _join(key, i)) for i, v in enumerate(value))
 
 
-def _parse_initial(raw: Mapping[str, Any], beam: Beam) -> InitialCondition:
+def _file_path(value: Any, key: str, base_dir: Path | None) -> tuple[Path, str]:
+    """A file name of the scenario, relative to its directory; and the name as written."""
+    file = _string(key, value)
+    path = Path(file).expanduser()
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    return path, file
+
+
+def _profile(ini: Mapping[str, Any], name: str, dimension: str, beam: Beam, base_dir: Path | None) -> Profile | None:
+    """``initial.<name>`` as rows ``[[x, value], ...]`` or ``initial.<name>_file``: a field along the beam."""
+    key, file_key = f"initial.{name}", f"initial.{name}_file"
+    rows = ini.get(name) if isinstance(ini.get(name), list) else None
+    if rows is not None and f"{name}_file" in ini:
+        raise ScenarioError(f"{file_key}: give the {name} as rows in {key} or in a file, not both", key=file_key)
+    if rows is not None:
+        x = [to_si(r[0], "length", f"{key}.{i}.0") for i, r in enumerate(rows)]
+        v = [to_si(r[1], dimension, f"{key}.{i}.1") for i, r in enumerate(rows)]
+    elif f"{name}_file" in ini:
+        path, file = _file_path(ini[f"{name}_file"], file_key, base_dir)
+        x, v = read_table(path, value_dimension=dimension, key=file_key, label=file, abscissa="length")
+        key = file_key
+    else:
+        return None
+    with _relabel(key):
+        profile = Profile(np.asarray(x), np.asarray(v), key)
+        profile.check_on(beam.length)
+    return profile
+
+
+def _parse_initial(raw: Mapping[str, Any], beam: Beam, base_dir: Path | None = None) -> InitialCondition:
     ini = raw.get("initial", {})
     tip = None
     if "tip_displacement" in ini:
@@ -253,8 +284,56 @@ def _parse_initial(raw: Mapping[str, Any], beam: Beam) -> InitialCondition:
         name: _float_list(f"initial.{name}", ini[name]) if name in ini else None
         for name in ("modal_displacement", "modal_velocity")
     }
+    velocity = None
+    if "velocity" in ini and not isinstance(ini["velocity"], list):
+        velocity = to_si(ini["velocity"], "velocity", "initial.velocity")
+    rotation = {name: to_si(ini[name], dim, f"initial.{name}") if name in ini else None
+                for name, dim in (("angular_velocity", "angular_velocity"), ("pivot", "length"))}
+    if rotation["pivot"] is not None:
+        rotation["pivot"] = _on_beam("initial.pivot", rotation["pivot"], beam.length)
+    for given, needs in (("angular_velocity", "pivot"), ("pivot", "angular_velocity")):
+        if rotation[given] is not None and rotation[needs] is None:
+            raise ScenarioError(
+                f"initial.{needs}: required with initial.{given} (a rigid rotation at angular_velocity "
+                f"[rad/s] about the point x = pivot [m])", key=f"initial.{needs}"
+            )
+    equilibrium = ini.get("equilibrium", False)
+    if not isinstance(equilibrium, bool):
+        raise ScenarioError(f"initial.equilibrium: expected true or false, got {describe_value(equilibrium)}",
+                            key="initial.equilibrium")
+    if equilibrium and "preload" not in raw:
+        raise ScenarioError("initial.equilibrium: needs a [preload] table (the constant load the equilibrium "
+                            "is taken under)", key="initial.equilibrium")
+    profiles = {name: _profile(ini, name, dim, beam, base_dir)
+                for name, dim in (("displacement", "length"), ("velocity", "velocity"))}
     with _relabel("initial"):
-        return InitialCondition(tip, position, modal["modal_displacement"], modal["modal_velocity"])
+        return InitialCondition(
+            tip, position, modal["modal_displacement"], modal["modal_velocity"], velocity,
+            rotation["angular_velocity"], rotation["pivot"], profiles["displacement"], profiles["velocity"],
+            equilibrium,
+        )
+
+
+def _parse_preload(raw: Mapping[str, Any], beam: Beam) -> Preload | None:
+    """``[preload]``: a constant gravity, base acceleration or point force acting during the whole run."""
+    if "preload" not in raw:
+        return None
+    pre = raw["preload"]
+    _required(pre, "preload", "kind", f" ({', '.join(repr(k) for k in PRELOAD_DIMENSIONS)})")
+    kind = _choice("preload.kind", pre["kind"], tuple(PRELOAD_DIMENSIONS))
+    dimension = PRELOAD_DIMENSIONS[kind]
+    _required(pre, "preload", "amplitude", f' for kind = "{kind}" ({describe_dimension(dimension)})')
+    amplitude = to_si(pre["amplitude"], dimension, "preload.amplitude")
+    position = None
+    if kind == "point_force":
+        position = _position(pre, "preload", beam.length, required=True)
+    else:
+        for name in ("position", "position_ratio"):
+            if name in pre:
+                raise ScenarioError(f'preload.{name}: has no effect with kind = "{kind}" (only with "point_force")',
+                                    key=f"preload.{name}")
+    with _relabel("preload"):
+        return Preload(kind, amplitude, position)  # type: ignore[arg-type]
 
 
 def _parse_solver(raw: Mapping[str, Any]) -> SolverOptions:

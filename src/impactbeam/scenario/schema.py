@@ -16,7 +16,7 @@ from typing import Any
 
 from ..exceptions import ScenarioError
 
-__all__ = ["EXCITATION_DIMENSIONS", "PSD_DIMENSIONS", "SUPPORT_DEFAULTS", "AMPLITUDE", "OUTPUT_FIELDS", "OUTPUT_FIELD_ALIASES", "scenario_paths", "path_dimension", "describe_value"]
+__all__ = ["EXCITATION_DIMENSIONS", "PSD_DIMENSIONS", "PRELOAD_DIMENSIONS", "SUPPORT_DEFAULTS", "AMPLITUDE", "PRELOAD_AMPLITUDE", "OUTPUT_FIELDS", "OUTPUT_FIELD_ALIASES", "scenario_paths", "path_dimension", "describe_value"]
 
 
 #: Physical dimension of ``excitation.amplitude`` (and of a table's values) per kind.
@@ -49,6 +49,15 @@ OUTPUT_FIELD_ALIASES = {"bending_moment": "moment", "bending_stress": "stress", 
 AMPLITUDE = "amplitude"
 #: The dimension of a level of ``excitation.psd``: set by ``excitation.kind`` (:data:`PSD_DIMENSIONS`).
 PSD_LEVEL = "psd_level"
+#: The dimension of ``preload.amplitude``: set by ``preload.kind`` (:data:`PRELOAD_DIMENSIONS`).
+PRELOAD_AMPLITUDE = "preload_amplitude"
+#: Physical dimension of ``preload.amplitude`` per ``preload.kind``.
+PRELOAD_DIMENSIONS: dict[str, str] = {
+    "gravity": "acceleration",
+    "base_acceleration": "acceleration",
+    "point_force": "force",
+}
+_PRELOAD_KINDS = tuple(PRELOAD_DIMENSIONS)
 
 
 @dataclass(frozen=True)
@@ -56,9 +65,10 @@ class _Leaf:
     """A value.
 
     ``dimension``: a key of :data:`impactbeam.units.DIMENSIONS`, ``"integer"``,
-    :data:`AMPLITUDE`, or None for a word (a name, a choice, a file).
+    :data:`AMPLITUDE`, :data:`PRELOAD_AMPLITUDE`, or None for a word (a name, a choice, a file).
     ``list_ok``: a list of values is allowed too; ``list_only``: must be a list.
-    ``columns``: a list of rows (``[[f, G], ...]``), each with these dimensions.
+    ``columns``: a list of rows (``[[f, G], ...]``, ``[[x, v], ...]``), each with these dimensions
+    (with ``list_ok`` and not ``list_only``, a single value is allowed too).
     """
 
     dimension: str | None = None
@@ -124,8 +134,13 @@ _SCHEMA = _Table(
                 **_values(tip_displacement="length", position="length"),
                 **_values(modal_displacement="dimensionless", modal_velocity="dimensionless",
                           list_ok=True, list_only=True),
+                "velocity": _Leaf("velocity", True, False, ("length", "velocity")),
+                "displacement": _Leaf("length", True, True, ("length", "length")),
+                **_values(angular_velocity="angular_velocity", pivot="length", displacement_file=None,
+                          velocity_file=None, equilibrium=None),
             }
         ),
+        "preload": _Table({**_values(kind=None, amplitude=PRELOAD_AMPLITUDE, **_POSITION)}),
         "solver": _Table(
             _values(
                 modes="integer", time_step="time", end_time="time", max_events="integer", event_tolerance="time",
@@ -264,7 +279,7 @@ def scenario_paths(data: Mapping[str, Any] | None = None) -> list[str]:
     return out
 
 
-def path_dimension(path: str, kind: str | None = None) -> str | None:
+def path_dimension(path: str, kind: str | None = None, preload_kind: str | None = None) -> str | None:
     """The dimension in which the value at a dotted scenario path is read.
 
     The one rule for the units of every scenario key: the scenario parser,
@@ -278,6 +293,8 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
         ``"damping.free.2"``, ``"output.points.1"``).
     kind : str, optional
         ``excitation.kind``, which sets the dimension of ``excitation.amplitude``.
+    preload_kind : str, optional
+        ``preload.kind``, which sets the dimension of ``preload.amplitude``.
 
     Returns
     -------
@@ -314,8 +331,12 @@ def path_dimension(path: str, kind: str | None = None) -> str | None:
     if node.dimension == AMPLITUDE:
         return EXCITATION_DIMENSIONS.get(kind or "")
     if node.columns:
+        if not indices:
+            return node.dimension  # a single value where one is allowed (a uniform initial velocity)
         if len(indices) < 2 or indices[1] >= len(node.columns):
             return None  # a row or the whole table: no single dimension
         column = node.columns[indices[1]]
         return PSD_DIMENSIONS.get(kind or "") if column == PSD_LEVEL else column
+    if node.dimension == PRELOAD_AMPLITUDE:
+        return PRELOAD_DIMENSIONS.get(preload_kind or "")
     return node.dimension

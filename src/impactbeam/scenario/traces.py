@@ -18,8 +18,9 @@ def read_table(
     value_dimension: str,
     key: str,
     label: str | None = None,
+    abscissa: str = "time",
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Read a two-column trace ``time, value`` from a CSV file, in SI units.
+    """Read a two-column trace ``time, value`` (or ``position, value``) from a CSV file, in SI units.
 
     The file is read by the same reader as measured records
     (:func:`impactbeam.experiment.load_record`), so both honour the same
@@ -38,10 +39,13 @@ def read_table(
         Dotted key reported in errors (``"excitation.file"``).
     label : str, optional
         How the file is named in messages (default: ``path`` as given).
+    abscissa : {"time", "length"}
+        Dimension of the first column: times of a trace, or positions along
+        the beam of a field (``[initial] displacement_file``).
 
     Returns
     -------
-    times : ndarray, shape (n,), [s]
+    times : ndarray, shape (n,), [s] (or [m])
         Strictly increasing, n >= 2.
     values : ndarray, shape (n,)
         In the SI unit of ``value_dimension``.
@@ -68,16 +72,19 @@ def read_table(
         return ScenarioError(f'{key}: "{name}" {detail}', key=key)
 
     where = "" if str(path) == name else f" (looked for {path})"
+    noun = "time" if abscissa == "time" else "position"
+    si = DIMENSIONS[abscissa].si_unit
     table = read_delimited(
-        path, fail, what="a trace", example=f"time [s],value [{DIMENSIONS[value_dimension].si_unit}]",
+        path, fail, what="a trace" if abscissa == "time" else "a field along the beam",
+        example=f"{noun} [{si}],value [{DIMENSIONS[value_dimension].si_unit}]",
         not_found=f"not found{where}",
     )
     if table.ncol != 2:
         raise fail(
-            f"line {table.first_line}: {table.ncol} columns ({', '.join(table.names)}), expected 2 (time, value)"
+            f"line {table.first_line}: {table.ncol} columns ({', '.join(table.names)}), expected 2 ({noun}, value)"
         )
     scales = [1.0, 1.0]
-    for j, dimension in enumerate(("time", value_dimension)):
+    for j, dimension in enumerate((abscissa, value_dimension)):
         unit = table.units[j]
         if unit is not None:
             try:
@@ -87,7 +94,8 @@ def read_table(
                 raise fail(
                     f'line {table.first_line}, column {j + 1} ({table.names[j]!r}), unit "{unit}": {detail}'
                 ) from None
-    (times, values), _ = numeric_columns(table, (0, 1), scales, fail)
+    (times, values), _ = numeric_columns(table, (0, 1), scales, fail, (noun, si))
     if times.size < 2:
-        raise fail(f"has {times.size} data row{'' if times.size == 1 else 's'}; a trace needs at least 2")
+        what = "a trace" if abscissa == "time" else "a field"
+        raise fail(f"has {times.size} data row{'' if times.size == 1 else 's'}; {what} needs at least 2")
     return times, values
