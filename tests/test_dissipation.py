@@ -270,7 +270,7 @@ def test_a_preload_alone_keeps_its_static_equilibrium():
     # start from rest instead: it oscillates about that deflection (mean = static) and the
     # exact engine and solve_ivp agree
     args = problem(excitation=Excitation(), contactors=(), points=[0.1092])
-    pre = Excitation(kind="point_force", shape="step", amplitude=-0.02, position=0.1092)
+    pre = ib.Preload("point_force", -0.02, 0.1092)
     res = ib.simulate_system(args["beam"], (), excitation=Excitation(), options=args["options"], points=[0.1092],
                              preload=pre, damping=Damping(0.5, 0.5))
     ivp = ib.simulate_system(args["beam"], (), excitation=Excitation(), options=args["options"], points=[0.1092],

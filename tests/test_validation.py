@@ -37,18 +37,11 @@ def report():
         return validate()
 
 
-def _awaits_engine(case) -> bool:
-    """SDNL32 needs free-mode damping and an initial rotation, which the engine does not take yet."""
-    return case.name == "SDNL32" and case.status == "not run" and "not supported by this version" in case.message
-
-
 def test_every_case_that_runs_is_within_its_tolerances(report):
-    # Reason: the manual's verdicts. Every judged check of every case that runs passes; the only case allowed
-    # not to run is SDNL32 until the engine integrates free-mode damping (then it must pass too).
+    # Reason: the manual's verdicts. Every judged check of every case passes (SDNL32 with free-mode damping and
+    # the initial rigid rotation included).
     assert [c.name for c in report.cases] == ["SDLX400", "SDNL32", "SDNL104", "Table2"]
     for case in report.cases:
-        if _awaits_engine(case):
-            continue
         assert case.status == "passed", f"{case.name}: {case.message}"
         assert all(c.passed in (True, None) for c in case.checks)
         assert sum(c.passed is True for c in case.checks) >= 2

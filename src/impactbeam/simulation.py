@@ -22,7 +22,7 @@ from ._warnings import emit_user_level_warning as warn
 from .exceptions import ParameterError
 from .model import Damping, SolverOptions
 from .model.beam import Beam, Contactor
-from .model.loading import Excitation, InitialCondition
+from .model.loading import Excitation, InitialCondition, Preload
 from .result import SimulationResult
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
 from .solver.convergence import AUTO_COUNTS, relative_changes
@@ -48,7 +48,7 @@ def simulate_system(
     progress: Callable[[float], None] | None = None,
     name: str = "system",
     start: ModalState | None = None,
-    preload: Excitation | None = None,
+    preload: Preload | None = None,
 ) -> SimulationResult:
     """Simulate a beam given as objects rather than as a scenario; see :func:`simulate`.
 
@@ -74,9 +74,9 @@ def simulate_system(
         Name of the run (in result files).
     start : ModalState, optional
         As for :func:`simulate`.
-    preload : Excitation, optional
-        A constant load acting throughout (``kind``, ``position``,
-        ``amplitude``): gravity as a base acceleration, or a point force.
+    preload : Preload, optional
+        The constant load of ``[preload]`` (gravity, a base acceleration or a
+        point force), acting throughout.
     """
     damping = damping or Damping()
     excitation = excitation or Excitation()
@@ -261,8 +261,6 @@ def simulate(
     are also listed in ``result.warnings``.
     """
     _require_scenario(scenario)
-    if scenario.preload is not None:
-        raise ParameterError("preload: not supported by this version of the solver")
     res = simulate_system(
         scenario.beam,
         scenario.contactors,
@@ -275,6 +273,7 @@ def simulate(
         progress=progress,
         name=scenario.name,
         start=start,
+        preload=scenario.preload,
     )
     object.__setattr__(res, "scenario", scenario)
     return res

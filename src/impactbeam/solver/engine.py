@@ -27,41 +27,22 @@ from collections.abc import Callable
 import numpy as np
 
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, InitialCondition, time_pieces
+from ..model.loading import Excitation, InitialCondition, Preload, time_pieces
 from ..modal import mode_set
 from . import _loop
 from ..model import Damping, SolverOptions
 from .solution import Event, Solution
 from .blocks import classical_slot, slot_arrays
+from .initial import initial_coordinates
 from .states import StateModel, StateSpace, _preload_key
 
-__all__ = ["integrate", "initial_coordinates", "pack"]
+__all__ = ["integrate", "pack"]
 
 _LOG = logging.getLogger("impactbeam")
 _ANNOUNCED = False
 _BUDGET = 200_000  # evaluations of the closed form between checkpoints (~20-50 ms)
 _CACHE: OrderedDict[tuple, _Packed] = OrderedDict()
 _CACHE_SIZE = 64
-
-
-def initial_coordinates(beam: Beam, initial: InitialCondition, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
-    """Free-state modal displacement and velocity at t = 0."""
-    ms = mode_set(beam, (), n_modes)
-    eta = np.zeros(ms.count)
-    deta = np.zeros(ms.count)
-    if initial.tip_displacement:
-        x0 = beam.length if initial.position is None else initial.position
-        # flexibility at x0 from a converged modal sum (terms fall as n^-4)
-        big = mode_set(beam, (), max(120, n_modes))
-        flex = float(np.sum(big.static_coordinates(x0) * big.shapes([x0])[:, 0]))
-        eta = ms.static_coordinates(x0, initial.tip_displacement / flex)
-    if initial.modal_displacement is not None:
-        v = np.asarray(initial.modal_displacement)
-        eta[: min(v.size, eta.size)] += v[: eta.size]
-    if initial.modal_velocity is not None:
-        v = np.asarray(initial.modal_velocity)
-        deta[: min(v.size, deta.size)] += v[: deta.size]
-    return eta, deta
 
 
 def make_space(beam, contactors, damping, excitation, options: SolverOptions, points, preload=None) -> StateSpace:
@@ -87,13 +68,6 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
             '(solver.basis = "paper"), which need more modes for stiff contactors'
         )
     return StateSpace(beam, contactors, damping, excitation, options.modes, points, preload)
-
-
-def space_initial_coordinates(space, beam: Beam, initial: InitialCondition, n_modes: int):
-    """Free-state (eta, deta) at t = 0 in the basis of ``space``."""
-    if hasattr(space, "initial_coordinates"):
-        return space.initial_coordinates(initial)
-    return initial_coordinates(beam, initial, n_modes)
 
 
 def kernels_cached() -> bool:
@@ -236,7 +210,7 @@ def pack(
     damping: Damping,
     excitation: Excitation,
     options: SolverOptions,
-    preload: Excitation | None = None,
+    preload: Preload | None = None,
 ) -> _Packed:
     """The packed problem, from the cache when its modes and transfers are already known."""
     key = (
@@ -327,7 +301,7 @@ def integrate(
     options: SolverOptions,
     progress: Callable[[float], None] | None = None,
     start: tuple[np.ndarray, np.ndarray] | None = None,
-    preload: Excitation | None = None,
+    preload: Preload | None = None,
 ) -> Solution:
     """Run the exact event-driven integration; see :func:`impactbeam.simulate`.
 
@@ -345,8 +319,8 @@ def integrate(
     start : tuple of ndarray, optional
         Free-state modal displacement and velocity at t = 0 (replaces
         ``initial``); see :meth:`Solution.modal_state`.
-    preload : Excitation, optional
-        A constant load acting throughout (kind, position, amplitude).
+    preload : Preload, optional
+        The constant load of ``[preload]``, acting throughout.
 
     Returns
     -------
@@ -369,7 +343,8 @@ def integrate(
     ic = np.zeros(_loop.N_INT, dtype=np.int64)
     ic[[_loop.I_JUST, _loop.I_PENDING, _loop.I_WARN_C]] = -1
     if start is None:
-        eta, deta = space_initial_coordinates(pk.space, beam, initial, options.modes)
+        eta, deta = initial_coordinates(pk.space, beam, initial, preload, contactors=contactors,
+                                        preserve_contacts=pk.preserve)
     else:
         eta, deta = (np.array(v, dtype=float) for v in start)
         if eta.shape != (nm,) or deta.shape != (nm,):

@@ -43,8 +43,9 @@ from scipy.optimize import brentq
 
 from ..model.beam import Beam, Contactor
 from ..exceptions import SimulationError
-from ..model.loading import Excitation, InitialCondition
-from .engine import make_space, space_initial_coordinates
+from ..model.loading import Excitation, InitialCondition, Preload
+from .engine import make_space
+from .initial import initial_coordinates
 from .solution import Event, PiecewiseSolution, Samples
 from ..model import Damping, SolverOptions
 from .states import StateModel
@@ -157,7 +158,7 @@ class _Reference:
         damping: Damping,
         excitation: Excitation,
         options: SolverOptions,
-        preload: Excitation | None = None,
+        preload: Preload | None = None,
     ) -> None:
         self.beam = beam
         self.contactors = contactors
@@ -302,20 +303,29 @@ class _Reference:
             y0 = np.concatenate([eta, deta])
             if engaged not in atol_state:
                 atol_state[engaged] = self.atol(st, y0)
-            sol = solve_ivp(
-                rhs, (t, t_stop), y0, method="DOP853", rtol=RTOL, atol=atol_state[engaged],
-                dense_output=True, events=evs or None, max_step=self.max_step,
-            )
-            if sol.status == -1:
-                raise SimulationError(f"solve_ivp failed at t = {t:.9g} s: {sol.message}")
+            # the initial state penetrates a stop (or a released dashpot pulls): switch at t = 0, as the
+            # engine does; later, a state left slightly inconsistent by eq. (12) is let run as before
+            wrong = [r for r, ev in enumerate(evs) if ev(t, y0) < -1e-12 * self.beam.length] if t == 0.0 else []
+            if wrong:
+                sol = None
+            else:
+                sol = solve_ivp(
+                    rhs, (t, t_stop), y0, method="DOP853", rtol=RTOL, atol=atol_state[engaged],
+                    dense_output=True, events=evs or None, max_step=self.max_step,
+                )
+                if sol.status == -1:
+                    raise SimulationError(f"solve_ivp failed at t = {t:.9g} s: {sol.message}")
             hit: tuple[float, int] | None = None
-            if sol.status == 1:
+            if sol is None:
+                hit = (t, wrong[0])
+            elif sol.status == 1:
                 for r, te in enumerate(sol.t_events):
                     if te.size and (hit is None or te[0] < hit[0]):
                         hit = (float(te[0]), r)
             t1 = hit[0] if hit is not None else float(sol.t[-1])
-            y1 = sol.sol(t1) if sol.sol is not None else y0
-            segments.append(IvpSegment(t, t1, engaged, IvpDense(sol.sol, t, t1, y0, y1)))
+            y1 = sol.sol(t1) if sol is not None and sol.sol is not None else y0
+            if sol is not None:
+                segments.append(IvpSegment(t, t1, engaged, IvpDense(sol.sol, t, t1, y0, y1)))
             eta, deta = y1[:n].copy(), y1[n:].copy()
             t = t1
             if hit is not None and rows[hit[1]][1] == "phase":
@@ -474,7 +484,7 @@ def integrate_ivp(
     excitation: Excitation,
     initial: InitialCondition,
     options: SolverOptions,
-    preload: Excitation | None = None,
+    preload: Preload | None = None,
 ) -> IvpSolution:
     """Integrate the modal model with :func:`scipy.integrate.solve_ivp` and terminal events.
 
@@ -489,8 +499,8 @@ def integrate_ivp(
     options : SolverOptions
         ``modes``, ``time_step`` (output sampling only), ``end_time``,
         ``max_events`` (chattering guard, status 1).
-    preload : Excitation, optional
-        A constant load acting throughout.
+    preload : Preload, optional
+        The constant load of ``[preload]``, acting throughout.
 
     Returns
     -------
@@ -515,5 +525,6 @@ def integrate_ivp(
     location).
     """
     ref = _Reference(beam, tuple(contactors), damping, excitation, options, preload)
-    eta, deta = space_initial_coordinates(ref.space, beam, initial, options.modes)
+    eta, deta = initial_coordinates(ref.space, beam, initial, preload, contactors=tuple(contactors),
+                                    preserve_contacts=options.projection == "contact")
     return ref.run(eta, deta)

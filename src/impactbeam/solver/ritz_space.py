@@ -22,7 +22,7 @@ import numpy as np
 from ..exceptions import ParameterError
 from ..model import Damping
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, InitialCondition, spatial_projection
+from ..model.loading import Excitation, Preload, spatial_projection
 from .ritz import RitzBasis, ritz_basis
 from .states import ProblemSpace, StateModel
 
@@ -144,7 +144,7 @@ class RitzStateSpace(ProblemSpace):
         excitation: Excitation,
         n_modes: int,
         points: np.ndarray,
-        preload: Excitation | None = None,
+        preload: Preload | None = None,
     ) -> None:
         super().__init__(beam, contactors, damping, excitation, n_modes, points, preload)
         for i, c in enumerate(self.contactors):
@@ -158,7 +158,6 @@ class RitzStateSpace(ProblemSpace):
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
         self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length,
                                      self.basis.inertia)
-        self._pre = self._preload_weights(self.basis.values, self.basis.integral, self.basis.inertia)
 
     @property
     def count(self) -> int:
@@ -175,7 +174,7 @@ class RitzStateSpace(ProblemSpace):
             Wc = np.ascontiguousarray((Phi.T @ self._psi_c).T) if self.contactors else np.zeros((0, n))
             Wo = np.ascontiguousarray((Phi.T @ self._psi_o).T) if self.points.size else np.zeros((0, n))
             dyn, C = self._dynamics(engaged, omega, Wc, lambda: Phi.T @ self.state(()).modes.Phi)
-            st = StateModel(engaged, ms, dyn, Wc, Wo, Phi.T @ self._p, Phi.T @ self._pre, C)  # type: ignore[arg-type]
+            st = StateModel(engaged, ms, dyn, Wc, Wo, Phi.T @ self._p, self._preload_weights(ms), C)  # type: ignore[arg-type]
             self._states[engaged] = st
         return st
 
@@ -200,34 +199,3 @@ class RitzStateSpace(ProblemSpace):
     def transfer(self, to: tuple[int, ...], frm: tuple[int, ...], preserve_contacts: bool = False) -> np.ndarray:
         """``T`` with ``eta_to = T @ eta_from``; exact, so ``preserve_contacts`` changes nothing."""
         return self.projection(to, frm)
-
-    def initial_coordinates(self, initial: InitialCondition) -> tuple[np.ndarray, np.ndarray]:
-        """Free-state modal displacement and velocity at t = 0 in this basis.
-
-        ``initial.tip_displacement``: the static equilibrium of the reduced
-        model under a point force at ``initial.position`` (default the tip),
-        scaled so that the reduced model's deflection there is exactly the
-        given one. ``modal_displacement`` / ``modal_velocity`` apply to the
-        retained free modes (the first ``N`` coordinates of the free state).
-        """
-        st = self.state(())
-        n = st.modes.count
-        eta, deta = np.zeros(n), np.zeros(n)
-        if initial.tip_displacement:
-            ms: RitzModes = st.modes  # type: ignore[assignment]
-            if ms.n_rigid:
-                raise ParameterError(
-                    "initial.tip_displacement: the supports allow rigid-body motion, so a static load shape does not exist"
-                )
-            x0 = self.beam.length if initial.position is None else initial.position
-            w0 = ms.shapes([x0])[:, 0]
-            q = w0 / ms.omega**2
-            eta = q * (initial.tip_displacement / float(w0 @ q))
-        # the free state's first N modes are the retained free modes, in order
-        N = self.basis.free.count
-        for src, dst in ((initial.modal_displacement, eta), (initial.modal_velocity, deta)):
-            if src is not None:
-                v = np.asarray(src, dtype=float)
-                m = min(v.size, N)
-                dst[:m] += v[:m]
-        return eta, deta

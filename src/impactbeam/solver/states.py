@@ -13,10 +13,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, spatial_projection
+from ..model.loading import Excitation, Preload, spatial_projection
 from ..modal import ModeSet, mode_set
 from ..model import Damping
 from .damping import dashpot_coefficient, state_damping_matrix
+from .equilibrium import preload_weights
 
 __all__ = ["ModalDynamics", "StateModel", "StateSpace"]
 
@@ -54,10 +55,8 @@ class ModalDynamics:
         return np.sqrt(np.where(self.over, -self._disc, 0.0))
 
 
-def _preload_key(preload: Excitation | None) -> tuple:
-    if preload is None:
-        return ()
-    return (preload.kind, preload.position, float(preload.amplitude) * float(getattr(preload, "scale", 1.0)))
+def _preload_key(preload: Preload | None) -> tuple:
+    return () if preload is None else (preload.kind, preload.position, float(preload.amplitude))
 
 
 # State models are pure functions of their inputs (all immutable), so they are
@@ -118,9 +117,8 @@ class ProblemSpace:
         Retained modes per state (the paper's N).
     points : ndarray, [m]
         Output positions.
-    preload : Excitation, optional
-        A constant load acting throughout (its ``kind``, ``position`` and
-        ``amplitude`` times ``scale``).
+    preload : Preload, optional
+        A constant load acting throughout (``[preload]``).
     """
 
     def __init__(
@@ -131,7 +129,7 @@ class ProblemSpace:
         excitation: Excitation,
         n_modes: int,
         points: np.ndarray,
-        preload: Excitation | None = None,
+        preload: Preload | None = None,
     ) -> None:
         self.beam = beam
         self.contactors = tuple(contactors)
@@ -181,11 +179,11 @@ class ProblemSpace:
             return ModalDynamics(omega, 0.5 * np.diag(C).copy()), None
         return ModalDynamics(omega, np.zeros_like(omega)), C
 
-    def _preload_weights(self, shapes_at, integral: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    def _preload_weights(self, modes) -> np.ndarray:
+        """The preload's constant modal force on a state's modes (zero without a preload)."""
         if self.preload is None:
-            return np.zeros_like(integral)
-        p = spatial_projection(self.preload, shapes_at, integral, self.beam.mass_per_length, inertia=inertia)
-        return p * float(self.preload.amplitude) * float(getattr(self.preload, "scale", 1.0))
+            return np.zeros(modes.count)
+        return preload_weights(self.preload, modes, self.beam)
 
 
 class StateSpace(ProblemSpace):
@@ -223,7 +221,7 @@ class StateSpace(ProblemSpace):
         Wo = np.ascontiguousarray(ms.shapes(self.points).T) if self.points.size else np.zeros((0, n))
         integral, inertia = ms.integral(), ms.inertia_integral()
         p = spatial_projection(self.excitation, ms.shapes, integral, self.beam.mass_per_length, inertia=inertia)
-        pre = self._preload_weights(ms.shapes, integral, inertia)
+        pre = self._preload_weights(ms)
         dyn, C = self._dynamics(engaged, ms.omega, Wc, lambda: ms.overlap(self.state(()).modes))
         return StateModel(engaged, ms, dyn, Wc, Wo, p, pre, C)
 
