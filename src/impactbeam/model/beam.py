@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -472,6 +472,28 @@ class Contactor:
             Deflection of the beam at the contactor.
         """
         return self.gap - self.direction * w_at_contact
+
+    def force(self, w_at_contact: Any, w_t_at_contact: Any, dashpot: float | None = None) -> Any:
+        """Force of the engaged contactor on the beam, ``max(k d + c d', 0)`` with ``d = s w(a) - gap``.
+
+        Positive whatever the side (it pushes the beam away from the
+        contactor); zero where it would pull. Only meaningful while engaged:
+        the events say when (a dashpot can hold ``d > 0`` after a release).
+
+        Parameters
+        ----------
+        w_at_contact, w_t_at_contact : float or ndarray, [m], [m/s]
+            Deflection and velocity of the beam at the contactor.
+        dashpot : float, optional, [N s/m]
+            The dashpot (default ``damping``; give the one the solver derived
+            from ``restitution``).
+        """
+        c = self.damping if dashpot is None else dashpot
+        d = self.direction * np.asarray(w_at_contact) - self.gap
+        f = self.stiffness * d
+        if c:
+            f = f + c * self.direction * np.asarray(w_t_at_contact)
+        return np.maximum(f, 0.0)
 
     def check_on(self, beam: Beam, name: str = "contactor") -> None:
         """Raise ParameterError unless the contactor lies on ``beam``.

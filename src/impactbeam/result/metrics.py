@@ -38,7 +38,7 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
     from ..model.beam import Contactor
 
-__all__ = ["compute_metrics", "contact_intervals", "response_point", "METRIC_UNITS", "METRIC_DISPLAY"]
+__all__ = ["compute_metrics", "contact_forces", "contact_intervals", "response_point", "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
 METRIC_UNITS = {
@@ -235,50 +235,72 @@ def _peak_query(result: ResultLike, ci: int, a: float, be: float) -> tuple:
     return (c.position, a, be, c.direction, -c.direction * c.gap, ci)
 
 
-def _impact_table(result: ResultLike, rows: list, peaks) -> list[dict[str, Any]]:
-    """Duration, peak force and impulse of every contact interval (exact, closed form).
+def contact_forces(result: ResultLike, intervals: Sequence[tuple[int, float, float]],
+                   compressions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Peak force and impulse of the contact force over intervals, in closed form.
 
-    The compression of contactor ``c`` is ``d = s w(a) - gap``; the force is
-    ``k d + c_d d'`` (``c_d`` its dashpot, 0 without). The peak force is the
-    maximum of that force over the interval and the impulse its integral,
-    ``k int d dt + c_d [d]``.
+    The force of contactor ``c`` while engaged is ``k d + c_d d'`` with the
+    compression ``d = s w(a) - gap`` and ``c_d`` its dashpot (0 without,
+    :attr:`~impactbeam.solver.solution.PiecewiseSolution.dashpots`): the peak
+    is the exact maximum of that force on the interval, the impulse its
+    integral ``k int d dt + c_d [d]``.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    intervals : sequence of (int, float, float)
+        ``(contactor, start, end)`` [s], each inside one contact of that contactor.
+    compressions : ndarray, optional
+        The largest compression on each interval, when already known (the
+        peak force of a contactor without dashpot is ``k`` times it).
+
+    Returns
+    -------
+    peaks, impulses : ndarray, [N], [N s]
     """
+    sol = result.solution
+    n = len(intervals)
+    if not n:
+        return np.zeros(0), np.zeros(0)
+    dash = getattr(sol, "dashpots", np.zeros(len(result.contactors)))
+    cs = [result.contactors[ci] for ci, _, _ in intervals]
+    k = np.array([c.stiffness for c in cs])
+    ints = sol.integrals([(c.position, a, b) for c, (_, a, b) in zip(cs, intervals)])
+    impulses = k * (np.array([c.direction for c in cs]) * ints - np.array([c.gap * (b - a) for c, (_, a, b)
+                                                                           in zip(cs, intervals)]))
+    rate = np.array([dash[ci] for ci, _, _ in intervals]) / k
+    queries = [_peak_query(result, ci, a, b) + (r,) for (ci, a, b), r in zip(intervals, rate)]
+    ask = [i for i in range(n) if compressions is None or rate[i] > 0.0]
+    peaks = np.full(n, np.nan) if compressions is None else np.asarray(compressions, dtype=float).copy()
+    if ask:
+        peaks[ask] = sol.extrema([queries[i] for i in ask])[:, 0]
+    forced = np.flatnonzero(rate > 0.0)
+    if forced.size:  # the dashpot's share of the impulse: c [d] over each interval, one evaluation for all
+        xs = np.unique([cs[i].position for i in forced])
+        ts = np.array([t for i in forced for t in intervals[i][1:]])
+        w = sol.sample(xs, ts).w
+        col = np.searchsorted(xs, [cs[i].position for i in forced])
+        for j, i in enumerate(forced):
+            d = cs[i].direction * w[2 * j: 2 * j + 2, col[j]] - cs[i].gap
+            impulses[i] += dash[intervals[i][0]] * float(d[1] - d[0])
+    return k * np.maximum(peaks, 0.0), impulses
+
+
+def _impact_table(result: ResultLike, rows: list, peaks) -> list[dict[str, Any]]:
+    """Duration, peak force and impulse of every contact interval (exact, closed form; :func:`contact_forces`)."""
     if not rows:
         return []
-    sol = result.solution
-    dash = getattr(sol, "dashpots", np.zeros(len(result.contactors)))
-    ints = sol.integrals([(result.contactors[ci].position, a, be) for ci, a, _, be in rows])
-    forced = [i for i, row in enumerate(rows) if dash[row[0]] > 0.0]
-    force_peaks = np.asarray(peaks, dtype=float).copy()
-    ends = {}
-    if forced:
-        fq = []
-        for i in forced:
-            ci, a, _, be = rows[i]
-            fq.append(_peak_query(result, ci, a, be) + (dash[ci] / result.contactors[ci].stiffness,))
-        force_peaks[forced] = sol.extrema(fq)[:, 0]
-        # the penetration at the start and the end of each contact, one evaluation for them all
-        xs = np.array([result.contactors[rows[i][0]].position for i in forced])
-        ts = np.array([t for i in forced for t in (rows[i][1], rows[i][3])])
-        w = sol.sample(np.unique(xs), ts).w
-        col = np.searchsorted(np.unique(xs), xs)
-        for j, i in enumerate(forced):
-            c = result.contactors[rows[i][0]]
-            ends[i] = c.direction * w[2 * j: 2 * j + 2, col[j]] - c.gap
+    force_peaks, impulses = contact_forces(result, [(ci, a, be) for ci, a, _, be in rows], peaks)
     out = []
-    for i, ((ci, a, b, be), peak, iw) in enumerate(zip(rows, force_peaks, ints)):
-        c = result.contactors[ci]
-        impulse = c.stiffness * (c.direction * float(iw) - c.gap * (be - a))
-        if i in ends:
-            impulse += dash[ci] * float(ends[i][1] - ends[i][0])
+    for (ci, a, b, be), peak, impulse in zip(rows, force_peaks, impulses):
         out.append(
             {
                 "contactor": ci,
                 "start": a,
                 "end": b if math.isfinite(b) else None,
                 "duration": (b - a) if math.isfinite(b) else None,
-                "peak_force": c.stiffness * max(float(peak), 0.0),
-                "impulse": impulse,
+                "peak_force": float(peak),
+                "impulse": float(impulse),
             }
         )
     out.sort(key=lambda d: (d["start"], d["contactor"]))

@@ -257,11 +257,8 @@ class SimulationResult:
         force = np.zeros((self.time.size, len(self.contactors)))
         dash = self.solution.dashpots
         for i, c in enumerate(self.contactors):
-            g = c.gap - c.direction * self.w_contact[:, i]
-            f = c.stiffness * -g
-            if dash[i] > 0.0:
-                f = f + dash[i] * c.direction * self.w_t_contact[:, i]
-            force[:, i] = np.where(self.engaged[:, i], np.maximum(f, 0.0), 0.0)
+            f = c.force(self.w_contact[:, i], self.w_t_contact[:, i], dash[i])
+            force[:, i] = np.where(self.engaged[:, i], f, 0.0)
         force[np.isnan(self.w_contact).any(axis=1)] = np.nan
         return force
 

@@ -23,8 +23,10 @@ duration ``T`` (:func:`~impactbeam.statistics.window.analysis_window`):
 * ``work_rate`` [W]: the mean of ``|F v|`` over the contact time (the power
   the contact exchanges; with friction it would be Archard's wear power).
 
-The contact force is ``k max(-g, 0)`` with the opening ``g`` of
-:meth:`~impactbeam.model.beam.Contactor.gap_function`. ``F^2`` and
+The contact force is :meth:`~impactbeam.model.beam.Contactor.force`,
+``max(k d + c d', 0)`` (``c`` the contactor's dashpot); peak forces and
+impulses are those of the result's impact table
+(:func:`~impactbeam.result.metrics.contact_forces`). ``F^2`` and
 ``|F v|`` are integrated by Gauss-Legendre quadrature on each side of the
 deepest compression (where ``|F v|`` has its kink), with panels of one
 period of the highest retained frequency and 8 nodes each: exact for
@@ -40,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from ..result.metrics import contact_forces
 from .window import analysis_window, top_frequency
 
 __all__ = ["ImpactStatistics", "impact_statistics", "IMPACT_UNITS"]
@@ -125,6 +128,7 @@ def _contactor(result: Any, ci: int, lo: float, hi: float, panel: float) -> tupl
     sol = result.solution
     c = result.contactors[ci]
     s = c.direction
+    dash = float(getattr(sol, "dashpots", np.zeros(ci + 1))[ci])
     all_iv = _intervals(result.events, ci, sol.t_end)
     started = [iv for iv in all_iv if lo <= iv[0] < hi]
     clipped = [(max(a, lo), min(b, hi)) for a, b, _, _ in all_iv if b > lo and a < hi]
@@ -137,26 +141,23 @@ def _contactor(result: Any, ci: int, lo: float, hi: float, panel: float) -> tupl
         tp = np.clip(np.nan_to_num(ext[:, 1], nan=0.5 * (a + b)), a, b)
         nodes, weights = _gauss(np.concatenate([a, tp]), np.concatenate([tp, b]), panel)
         smp = sol.sample(np.array([c.position]), nodes)
-        force = c.stiffness * np.maximum(-c.gap_function(smp.w[:, 0]), 0.0)
+        force = c.force(smp.w[:, 0], smp.w_t[:, 0], dash)
         f2 = float(np.sum(weights * force**2))
         fv = float(np.sum(weights * np.abs(force * smp.w_t[:, 0])))
-        ints = sol.integrals([(c.position, ai, bi) for ai, bi in zip(a, b)])
-        f1 = float(np.sum(c.stiffness * (s * ints - c.gap * (b - a))))
+        f1 = float(np.sum(contact_forces(result, [(ci, ai, bi) for ai, bi in zip(a, b)])[1]))
         t_contact = float(np.sum(b - a))
     rows: list[dict[str, Any]] = []
     whole = [iv for iv in started if iv[1] <= hi and math.isfinite(iv[3])]
     if whole:
         a = np.array([r[0] for r in whole])
         b = np.array([r[1] for r in whole])
-        peaks = sol.extrema([(c.position, ai, bi, s, -s * c.gap, ci) for ai, bi in zip(a, b)])[:, 0]
-        ints = sol.integrals([(c.position, ai, bi) for ai, bi in zip(a, b)])
-        for (ta, tb, vin, vout), pk, iw in zip(whole, peaks, ints):
+        peaks, impulses = contact_forces(result, [(ci, ai, bi) for ai, bi in zip(a, b)])
+        for (ta, tb, vin, vout), pk, imp in zip(whole, peaks, impulses):
             v_in, v_out = s * vin, s * vout
             rows.append({
                 "contactor": ci, "start": ta, "end": tb, "duration": tb - ta, "impact_velocity": v_in,
                 "exit_velocity": v_out, "restitution": -v_out / v_in if v_in != 0.0 else math.nan,
-                "peak_force": c.stiffness * max(float(pk), 0.0),
-                "impulse": c.stiffness * (s * float(iw) - c.gap * (tb - ta)),
+                "peak_force": float(pk), "impulse": float(imp),
             })
 
     def over(key: str, fn: Any = np.mean) -> float:
