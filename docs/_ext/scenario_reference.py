@@ -189,8 +189,9 @@ def _kind(node: Any) -> str:
         return "preset name or table" if node.preset_ok else "table"
     if isinstance(node, S._Array):
         return "array of tables"
-    if node.rows:
-        return "rows [x, value]" if node.list_only else "value or rows [x, value]"
+    if node.columns:
+        row = "rows [" + ", ".join(c.replace("psd_level", "level") for c in node.columns) + "]"
+        return row if node.list_only else f"value or {row}"
     if node.list_only:
         return "list"
     return "value or list" if node.list_ok else "value"
