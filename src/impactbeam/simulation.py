@@ -25,7 +25,7 @@ from .model.beam import Beam, Contactor
 from .model.loading import Excitation, InitialCondition
 from .result import SimulationResult
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
-from .solver.convergence import AUTO_COUNTS, relative_changes
+from .solver.convergence import AUTO_COUNTS, coarser_counts, estimate
 
 if TYPE_CHECKING:
     from .scenario import Scenario
@@ -143,17 +143,24 @@ def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contact
 
 
 def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> SimulationResult:
-    """``solver.modes = "auto"``: add modes until the metrics change by less than ``tolerance``."""
-    prev = None
+    """``solver.modes = "auto"``: add modes until every Table-2 metric's estimated error is below ``tolerance``.
+
+    The counts of :data:`~impactbeam.solver.convergence.AUTO_COUNTS` in turn;
+    each is estimated against the two counts before it, as a run with that
+    fixed count is (:mod:`impactbeam.solver.convergence`). The result is that
+    of the first count below the tolerance (or of the last count, with its
+    estimate and the unconverged warning).
+    """
+    done: dict[int, dict] = {}
     for n in AUTO_COUNTS:
         res = run(n, announce=False)
-        m = res.metrics(impacts=False)
-        if prev is not None:
-            changes = relative_changes(m, prev)
-            res.set_convergence(changes)
-            if max(changes.values()) < tolerance:
+        done[n] = res.metrics()
+        counts = coarser_counts(n)
+        if all(c in done for c in counts):
+            metrics, peaks = estimate(done[n], [done[c] for c in counts])
+            res.set_convergence(metrics, peaks, counts)
+            if max(metrics.values()) < tolerance:
                 break
-        prev = m
     for text in res.warnings:
         warn(text)
     return res
