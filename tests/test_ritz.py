@@ -22,16 +22,8 @@ The modal maximum penetration is located on the exact solution (dense
 output, Brent on the velocity inside every contact interval), never on the
 output grid.
 
-Measured (specimen, paper orientation of Case 3, gap 0.229 mm, 0.2 s):
-
-==========  =====  ========  ================  =============  ==============
-k [N/m]     modes  basis     impacts (FE)      max pen. [um]  FE 100 el [um]
-==========  =====  ========  ================  =============  ==============
-1e5         8      enriched  26 (26)           29.646         29.625
-1e5         8      paper     69 (26)           24.788         29.625
-1e6         16     enriched  52 (52)           5.1546         5.1446
-1e6         16     paper     231 (52)          1143.5         5.1446
-==========  =====  ========  ================  =============  ==============
+Measured: the table of docs/solver-verification.md ("Stiff contactors"),
+recomputed and compared by ``test_docs_stiff_table_is_what_the_code_gives``.
 """
 
 from __future__ import annotations
@@ -43,7 +35,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-import fe_reference as fr
+from fe_cases import fe_run
 import impactbeam as ib
 from impactbeam.exceptions import ParameterError
 from impactbeam.modal import mode_set
@@ -256,24 +248,10 @@ def _modal(sc: ib.Scenario) -> dict:
 
 
 def _fe(sc: ib.Scenario, n_el: int, dt: float) -> dict:
-    beam, c, exc = sc.beam, sc.contactors[0], sc.excitation
-    load = dict(kind="base_acceleration", amplitude=exc.amplitude * exc.scale, duration=exc.duration, start=exc.start)
-    supp = lambda s: (s.translational, s.rotational)  # noqa: E731
-    structure = {
-        "sections": [(p.length, p.bending_stiffness, p.mass_per_length) for p in beam.sections],
-        "masses": [(m.position, m.mass, m.rotary_inertia) for m in beam.masses],
-        "springs": [(sp.position, sp.translational) for sp in beam.springs if sp.translational],
-        "rotational_springs": [(sp.position, sp.rotational) for sp in beam.springs if sp.rotational],
-    }
-    r = fr.fe_transient(
-        beam.length, beam.bending_stiffness, beam.mass_per_length, left=supp(beam.left), right=supp(beam.right),
-        contactors=[dict(position=c.position, stiffness=c.stiffness, gap=c.gap, side=c.side)], load=load,
-        damping=(float(sc.damping.free), float(sc.damping.contact)), dt=dt, t_end=sc.solver.end_time,
-        n_elements=n_el, output_x=[c.position], **structure,
-    )
-    imp = [t for t, kind, i in r.events if kind == "impact"]
-    reb = [t for t, kind, i in r.events if kind == "rebound"]
-    return {"n_impacts": len(imp), "max_penetration": float(np.max(c.direction * r.w[:, 0])) - c.gap,
+    r = fe_run(sc, n_el, dt)  # cached for the session (tests/fe_cases.py)
+    imp = [t for t, kind in r.events if kind == "impact"]
+    reb = [t for t, kind in r.events if kind == "rebound"]
+    return {"n_impacts": len(imp), "max_penetration": float(r.force.max()) / sc.contactors[0].stiffness,
             "first_contact": reb[0] - imp[0], "first_impact_time": imp[0]}
 
 
@@ -484,3 +462,74 @@ def test_basis_on_structures_is_orthonormal_and_diagonalises_the_stiffness(examp
     assert sp.basis.roundoff < 1e-6
     assert np.abs(M - np.eye(sp.count)).max() < sp.basis.roundoff
     assert np.abs(K - np.diag(sp.basis.lam)).max() < sp.basis.roundoff * sp.basis.lam.max()
+
+
+def test_contact_time_of_a_very_stiff_stop():
+    # The figures of docs/convergence.md and solver/ritz_enrich.py: a 1e7 N/m stop on the specimen
+    # at 0.484 L loads the beam within t_c = (EI^(1/4) (rho A)^(3/4) / k)^(2/3) = 2.2 us (the infinite
+    # beam's deflection under a step force F grows as F t^(3/2) / (EI^(1/4) (rho A)^(3/4)), so it
+    # reaches F / k then: dimensional analysis), over (EI / rho A)^(1/4) t_c^(1/2) = 1.6 mm, about
+    # 74 kHz (1 / (2 pi t_c)) where 16 free modes reach 38 kHz; the enriched basis adds the local
+    # shapes at 1, 2, 4 and 8 / t_c.
+    from impactbeam.solver.ritz_enrich import contact_time
+
+    sc = _specimen(**{"contactors.0.stiffness": 1e7})
+    beam, c = sc.beam, sc.contactors[0]
+    tc = contact_time(beam, c.position, c.stiffness)
+    EI, rA = beam.bending_stiffness, beam.mass_per_length
+    assert tc == pytest.approx((EI**0.25 * rA**0.75 / 1e7) ** (2 / 3), rel=1e-12)
+    assert round(tc * 1e6, 1) == 2.2
+    assert round((EI / rA) ** 0.25 * math.sqrt(tc) * 1e3, 1) == 1.6
+    assert round(1 / (2 * math.pi * tc) / 1e3) == 74
+    assert round(mode_set(beam, (), 16).frequencies_hz[-1] / 1e3) == 38
+    basis = ritz_basis(beam, [c.position], 16, [(c.position, c.stiffness)])
+    np.testing.assert_allclose(basis.enrichment.shifts, [2**j / tc for j in range(4)], rtol=1e-12)
+
+
+def _stiff_table() -> list[list[str]]:
+    """The table of docs/solver-verification.md (section "Stiff contactors"), from fresh runs."""
+    rows = []
+    for label, k, modes, paper in (("k = 1e5 N/m", 1e5, (8, 32), 8), ("k = 1e6 N/m", 1e6, (16, 32), 16)):
+        sc = _specimen(**{"contactors.0.stiffness": k})
+        fe = [_fe(sc, n, dt) for n, dt in FE_RUNS]
+        ref = fe[1]["max_penetration"]
+        rows.append([label, "FE 50 el. / 100 el.", f"{fe[0]['n_impacts']} / {fe[1]['n_impacts']}",
+                     f"{fe[0]['max_penetration'] * 1e6:.6g} / {ref * 1e6:.6g}",
+                     f"{fe[0]['first_contact'] * 1e3:.6f} / {fe[1]['first_contact'] * 1e3:.6f}"])
+        for basis, n in [("enriched", m) for m in modes] + [("paper", paper)]:
+            run = sc.with_values({"solver.modes": n, "solver.basis": basis})
+            m = _modal(run)
+            fns = ib.simulate(run.with_values({"solver.end_time": 1e-3})).solution.n_modes
+            rows.append(["", f"{basis}, {n} ({fns} functions)", str(m["n_impacts"]),
+                         f"{m['max_penetration'] * 1e6:.6g} ({100 * (m['max_penetration'] / ref - 1):+.2f} %)",
+                         f"{m['first_contact'] * 1e3:.6f}"])
+    sc = _tip_stop()
+    fe = [_fe(sc, n, dt) for n, dt in FE_RUNS]
+    ref = fe[1]["max_penetration"]
+    rows.append(["tip stop, 1e5 N/m", "FE 50 el. / 100 el.", f"{fe[0]['n_impacts']} / {fe[1]['n_impacts']}",
+                 f"{fe[0]['max_penetration'] * 1e6:.6g} / {ref * 1e6:.6g}",
+                 f"{fe[0]['first_contact'] * 1e3:.6f} / {fe[1]['first_contact'] * 1e3:.6f}"])
+    for basis, n in (("enriched", 8), ("enriched", 10), ("enriched", 12), ("enriched", 16), ("paper", 8)):
+        run = sc.with_values({"solver.modes": n, "solver.basis": basis})
+        m = _modal(run)
+        fns = ib.simulate(run.with_values({"solver.end_time": 1e-3})).solution.n_modes
+        rows.append(["", f"{basis}, {n} ({fns} functions)", str(m["n_impacts"]),
+                     f"{m['max_penetration'] * 1e6:.6g} ({100 * (m['max_penetration'] / ref - 1):+.2f} %)",
+                     f"{m['first_contact'] * 1e3:.6f}"])
+    return rows
+
+
+@pytest.mark.slow
+def test_docs_stiff_table_is_what_the_code_gives(capsys):
+    # docs/solver-verification.md ("Stiff contactors"): every cell recomputed (the FE runs are those
+    # of the tests above, cached for the session) and compared as text.
+    rows = _stiff_table()
+    with capsys.disabled():
+        print()
+        for r in rows:
+            print("| " + " | ".join(r) + " |")
+    text = (Path(__file__).resolve().parents[1] / "docs" / "solver-verification.md").read_text()
+    block = text.split("<!-- stiff -->")[1].split("<!-- end -->")[0]
+    doc = [[c.strip() for c in line.strip().strip("|").split("|")] for line in block.splitlines()
+           if line.startswith("|") and not line.startswith("|---") and not line.startswith("| case")]
+    assert doc == rows

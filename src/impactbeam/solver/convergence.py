@@ -47,12 +47,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 __all__ = [
-    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "coarser_counts", "estimate", "impact_changes", "relative_changes",
+    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "ConvergenceStudy", "coarser_counts", "estimate", "impact_changes", "relative_changes",
     "worst",
 ]
 
@@ -202,3 +203,78 @@ def worst(changes: Mapping[str, float]) -> tuple[str, float]:
     """
     key = max(changes, key=lambda k: changes[k])
     return key, changes[key]
+
+
+@dataclass(frozen=True)
+class ConvergenceStudy:
+    """The Table-2 metrics of one scenario against the number of modes, each with its error estimate.
+
+    Attributes
+    ----------
+    name : str
+        The scenario's name.
+    counts : tuple of int
+        Modes per state of the runs shown, ascending.
+    functions : dict of int -> int
+        Functions per state of each run (the enriched basis adds attachment
+        shapes and, for stiff stops, more: :mod:`~impactbeam.solver.ritz`).
+    metrics : dict of int -> dict
+        The metrics of each run (SI, None where undefined).
+    estimates : dict of int -> dict or None
+        The estimated relative error of each metric (None where a coarser
+        count is missing: the smallest counts).
+    peak_forces : dict of int -> list of float
+        Each run's impacts' peak forces [N].
+    peak_force_estimates : dict of int -> list of float or None
+        Their estimated relative errors.
+    tolerance : float
+        ``solver.tolerance`` of the scenario.
+    """
+
+    name: str
+    counts: tuple[int, ...]
+    functions: dict[int, int]
+    metrics: dict[int, dict[str, Any]]
+    estimates: dict[int, dict[str, float] | None]
+    peak_forces: dict[int, list[float]] = field(default_factory=dict)
+    peak_force_estimates: dict[int, list[float] | None] = field(default_factory=dict)
+    tolerance: float = 2e-3
+
+    @property
+    def converged_count(self) -> int | None:
+        """The smallest count whose every Table-2 estimate is below the tolerance (None if none is)."""
+        for n in self.counts:
+            est = self.estimates.get(n)
+            if est is not None and max(est.values()) < self.tolerance:
+                return n
+        return None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The study as plain data (the ``--json`` of ``impactbeam convergence``).
+
+        Keys: ``scenario``, ``tolerance``, ``metrics`` (the Table-2 names),
+        ``converged_modes`` (:attr:`converged_count`), ``runs``: one per count,
+        ``{"modes", "functions", "values": {metric: value}, "estimates":
+        {metric: relative error} or null, "peak_force": {"max": N,
+        "max_estimate": relative error of the largest impact's peak force,
+        "worst_estimate": largest over the impacts} or null}``.
+        """
+        runs = []
+        for n in self.counts:
+            forces = self.peak_forces.get(n) or []
+            pest = self.peak_force_estimates.get(n)
+            peak = None
+            if forces:
+                j = int(np.argmax(forces))
+                peak = {"max": float(forces[j]),
+                        "max_estimate": None if pest is None else float(pest[j]),
+                        "worst_estimate": None if pest is None else float(max(pest))}
+            runs.append({
+                "modes": n,
+                "functions": self.functions[n],
+                "values": {k: self.metrics[n].get(k) for k in CONVERGENCE_METRICS},
+                "estimates": self.estimates.get(n),
+                "peak_force": peak,
+            })
+        return {"scenario": self.name, "tolerance": self.tolerance, "metrics": list(CONVERGENCE_METRICS),
+                "converged_modes": self.converged_count, "runs": runs}
