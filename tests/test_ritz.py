@@ -339,9 +339,14 @@ def test_engaged_modes_join_only_when_the_basis_misses_them():
     # Ritz frequencies of that state are its exact ones (7.8e-10 measured; the
     # part of a mode below 1e-3 of its norm outside the basis is left out, a
     # second-order change in frequency: 1e-6 at most).
+    from impactbeam.solver.ritz_enrich import _engaged_outside
+
     case3 = ib.load_scenario(EXAMPLES / "case03.toml")
     c = case3.contactors[0]
-    assert ritz_basis(case3.beam, [c.position], 8, [(c.position, c.stiffness)]).count == 9
+    b3 = ritz_basis(case3.beam, [c.position], 8, [(c.position, c.stiffness)])
+    assert b3.count == 9
+    outside = _engaged_outside(case3.beam, b3.free, b3._rho_at, b3._samples, {0: c.stiffness}, b3.positions)
+    assert 1e-4 < outside < 0.5e-3  # 1.8e-4
     sc = _tip_stop()
     c = sc.contactors[0]
     sp = RitzStateSpace(sc.beam, sc.contactors, sc.damping, sc.excitation, 8, np.zeros(0))
@@ -356,9 +361,9 @@ def test_engaged_modes_join_only_when_the_basis_misses_them():
     # coefficients up to |A_rho|_1 = 21 (the attachment shape's part beyond the
     # reference modes has 4.6e-4 of its mass). The basis's round-off bound
     # RitzBasis.roundoff = 4 N eps (g / r) |A_rho|_1 is 4.6e-9; measured 1.6e-11 /
-    # 1.5e-11 (mass / stiffness) with AVX-512, 8.8e-12 / 1.1e-11 as on AVX2 without
+    # 7.5e-12 (mass / stiffness) with AVX-512, 8.8e-12 / 5.3e-12 as on AVX2 without
     # AVX-512 (OpenBLAS Haswell kernels, NumPy without AVX-512, numba for haswell),
-    # 5.1e-11 / 2.2e-11 with Sandybridge kernels, 4.2e-11 / 1.9e-11 without FMA
+    # 5.1e-11 / 1.1e-11 with Sandybridge kernels, 4.2e-11 / 9.4e-12 without FMA
     # (Prescott). Before, a column-pivoted QR chose between columns of equal norm by
     # round-off (a different basis on each machine: penetration 2e-5 apart) and
     # amplified the residuals' round-off by its R^-1 (6.4e-9 on an AMD EPYC).

@@ -147,7 +147,7 @@ class RitzBasis:
             # with rigid-body modes the inertia-relief attachment shapes obey another identity)
             if contact and not self.free.n_rigid:
                 self.enrichment = enrich(beam, self.free, self.positions, self._Z, self._rho_at,
-                                         self._gram, contact, loads)
+                                         self._samples, contact, loads)
                 if self.enrichment is not None:
                     lr = self.enrichment.lam
         self.lam = np.concatenate([self.free.omega**2, lr])
@@ -221,16 +221,27 @@ class RitzBasis:
         return np.concatenate(parts)
 
     def _gram(self, fn, bmax: float) -> tuple[np.ndarray, np.ndarray]:
-        """Kinetic and strain-energy inner products of the functions ``fn(x, field)``.
+        """Kinetic and strain-energy inner products of the functions ``fn(x, field)`` (see :meth:`_samples`)."""
+        S, E = self._samples(fn, bmax)
+        assert E is not None
+        return S.T @ S, E.T @ E
+
+    def _samples(self, fn, bmax: float, strain: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """Weighted samples ``(S, E)`` of the functions ``fn(x, field)``: ``S^T S`` and ``E^T E`` are their inner products.
 
         On a quadrature resolving the wavenumber ``bmax`` (split at the
-        contactors and every node of the beam): ``int rho A f g`` (and the
-        rotary terms, the point masses) and ``int M_f M_g / EI`` (plus
-        ``int kappa G A (f' - Psi_f)(g' - Psi_g)`` for a Timoshenko beam) with
-        the finite translational and rotational springs of the supports.
+        contactors and every node of the beam): the kinetic ``int rho A f g``
+        (and the rotary terms, the point masses) and the strain energy
+        ``int M_f M_g / EI`` (plus ``int kappa G A (f' - Psi_f)(g' - Psi_g)``
+        for a Timoshenko beam) with the finite translational and rotational
+        springs of the supports (``E`` is None without ``strain``). Linear in
+        the functions, so the samples of a combination are the combination of
+        the samples.
         """
         quad = self._quadrature(bmax)
         S = self._sample(fn, quadrature=quad)
+        if not strain:
+            return S, None
         x, w = quad
         beam = self.beam
         parts = [(fn(x, "moment") * np.sqrt(w / beam.bending_stiffness_at(x))).T]
@@ -244,8 +255,7 @@ class RitzBasis:
             for value, field in ((k, 0), (kt, "rot")):
                 if 0.0 < value < math.inf:
                     parts.append(math.sqrt(value) * fn(np.array([xs]), field).T)
-        E = np.concatenate(parts)
-        return S.T @ S, E.T @ E
+        return S, np.concatenate(parts)
 
     def _free_at(self, x: np.ndarray, field: int | str) -> np.ndarray:
         return _mode_field(self.free, x, field)
