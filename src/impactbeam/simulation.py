@@ -20,17 +20,17 @@ import numpy as np
 
 from ._warnings import emit_user_level_warning as warn
 from .exceptions import ParameterError
-from .model import Damping, SolverOptions
+from .model import MAX_MODES, Damping, SolverOptions
 from .model.beam import Beam, Contactor
 from .model.loading import Excitation, InitialCondition, Preload
 from .result import SimulationResult
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
-from .solver.convergence import AUTO_COUNTS, relative_changes
+from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, estimate
 
 if TYPE_CHECKING:
     from .scenario import Scenario
 
-__all__ = ["simulate", "simulate_system"]
+__all__ = ["convergence_study", "simulate", "simulate_system"]
 
 Method = Literal["exact", "ivp"]
 
@@ -147,20 +147,88 @@ def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contact
 
 
 def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> SimulationResult:
-    """``solver.modes = "auto"``: add modes until the metrics change by less than ``tolerance``."""
-    prev = None
+    """``solver.modes = "auto"``: add modes until every Table-2 metric's estimated error is below ``tolerance``.
+
+    The counts of :data:`~impactbeam.solver.convergence.AUTO_COUNTS` in turn;
+    each is estimated against the two counts before it, as a run with that
+    fixed count is (:mod:`impactbeam.solver.convergence`). The result is that
+    of the first count below the tolerance (or of the last count, with its
+    estimate and the unconverged warning).
+    """
+    done: dict[int, dict] = {}
     for n in AUTO_COUNTS:
         res = run(n, announce=False)
-        m = res.metrics(impacts=False)
-        if prev is not None:
-            changes = relative_changes(m, prev)
-            res.set_convergence(changes)
-            if max(changes.values()) < tolerance:
+        done[n] = res.metrics()
+        counts = coarser_counts(n)
+        if all(c in done for c in counts):
+            metrics, peaks = estimate(done[n], [done[c] for c in counts])
+            res.set_convergence(metrics, peaks, counts)
+            if max(metrics.values()) < tolerance:
                 break
-        prev = m
     for text in res.warnings:
         warn(text)
     return res
+
+
+def convergence_study(
+    scenario: Scenario,
+    counts: Sequence[int] | None = None,
+    *,
+    max_modes: int = 64,
+    progress: Callable[[float], None] | None = None,
+) -> ConvergenceStudy:
+    """The Table-2 metrics against the number of modes, each with its error estimate.
+
+    Every count is run, and the counts its estimate compares with
+    (:func:`~impactbeam.solver.convergence.coarser_counts`), so each row
+    carries the estimate a run with that fixed count reports
+    (``result.convergence``).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    counts : sequence of int, optional
+        Modes per state to show; default those of ``solver.modes = "auto"``,
+        4, 6, 8, 12, 16, ... up to ``max_modes``.
+    max_modes : int
+        Largest count of the default ladder.
+    progress : callable, optional
+        Called with the fraction of the runs done (0..1).
+
+    Returns
+    -------
+    ConvergenceStudy
+    """
+    _require_scenario(scenario)
+    if counts is None:
+        shown = [n for n in AUTO_COUNTS if n <= max_modes]
+    else:
+        shown = sorted({int(n) for n in counts})
+    if not shown or shown[0] < 1 or shown[-1] > MAX_MODES:
+        raise ParameterError(f"counts: expected mode counts from 1 to {MAX_MODES}, got {list(counts or shown)}")
+    needed = sorted({c for n in shown for c in (n, *coarser_counts(n))})
+    cost = [float(n) for n in needed]
+    done: dict[int, SimulationResult] = {}
+    for i, n in enumerate(needed):
+        done[n] = simulate(scenario.with_values({"solver.modes": n}))
+        if progress is not None:
+            progress(sum(cost[: i + 1]) / sum(cost))
+    table = {n: r.metrics() for n, r in done.items()}
+    estimates: dict[int, dict[str, float] | None] = {}
+    peak_estimates: dict[int, list[float] | None] = {}
+    for n in shown:
+        coarse = coarser_counts(n)
+        if coarse:
+            est, peaks = estimate(table[n], [table[c] for c in coarse])
+            estimates[n], peak_estimates[n] = est, [float(p) for p in peaks]
+        else:
+            estimates[n] = peak_estimates[n] = None
+    return ConvergenceStudy(
+        name=scenario.name, counts=tuple(shown), functions={n: int(done[n].solution.n_modes) for n in shown},
+        metrics={n: table[n] for n in shown}, estimates=estimates,
+        peak_forces={n: [float(r["peak_force"]) for r in table[n].get("impacts", [])] for n in shown},
+        peak_force_estimates=peak_estimates, tolerance=float(scenario.solver.tolerance),
+    )
 
 
 def _check_distinct(contactors: tuple[Contactor, ...]) -> None:

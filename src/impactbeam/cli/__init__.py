@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from . import (
     cmd_bifurcation,
+    cmd_convergence,
     cmd_explore,
     cmd_info,
     cmd_measure,
@@ -35,6 +36,7 @@ __all__ = ["main", "handle_errors", "take_warnings", "warning_lines", "load_with
 for _command in (
     cmd_modes.modes,
     cmd_simulate.simulate,
+    cmd_convergence.convergence,
     cmd_reproduce.reproduce,
     cmd_sweep.sweep_command,
     cmd_sweep.plot_command,

@@ -22,7 +22,7 @@ from .style import SERIES_STYLES, _log_ticks, _outside_legend, _side_legend, _st
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["plot_parameter_study", "plot_convergence"]
+__all__ = ["plot_parameter_study", "plot_convergence", "plot_convergence_study"]
 
 
 @_styled
@@ -171,3 +171,117 @@ def plot_convergence(
         ax.set_title(title)
     leg = _outside_legend(fig, ax, ncols=1) if own else _side_legend(ax)
     return _finish(PlotHandles(fig, (ax,), tuple(lines), {"legend": leg}), path, dpi)
+
+
+@_styled
+def plot_convergence_study(
+    modes: Sequence[int],
+    values: Mapping[str, Sequence[float | None]],
+    estimates: Mapping[str, Sequence[float | None]],
+    *,
+    axes: Sequence[Axes] | None = None,
+    metric_labels: Mapping[str, str] | None = None,
+    tolerance: float | None = None,
+    title: str | None = None,
+    size: str | tuple[float, float] = "double",
+    path: str | os.PathLike[str] | None = None,
+    dpi: int = 300,
+) -> PlotHandles:
+    """One panel per metric: its estimated relative error and its change from the most modes, against the modes.
+
+    The estimate (solid, filled markers) is what every result of that count
+    reports (``result.convergence``); the change from the largest count
+    (dotted, open markers) is the error of the smaller counts as far as the
+    largest one is converged. Both on log axes; zeros and missing values are
+    left out.
+
+    Parameters
+    ----------
+    modes : sequence of int
+        Modes per state of each run, ascending.
+    values : mapping of name -> sequence
+        Each metric's value per count (None where undefined).
+    estimates : mapping of name -> sequence
+        Each metric's estimated relative error per count (None where there is none).
+    axes : sequence of Axes, optional
+        One per metric; default a grid of 2 columns.
+    metric_labels : mapping of name -> str, optional
+        Panel titles (default the names).
+    tolerance : float, optional
+        Draws ``solver.tolerance`` as a grey dashed line.
+    title : str, optional
+    size : {"single", "double"} or (width, height)
+    path : path-like, optional
+        Also save the figure there.
+    dpi : int
+        Resolution of raster formats.
+
+    Returns
+    -------
+    PlotHandles
+    """
+    names = list(values)
+    if not names:
+        raise ParameterError("values: at least one metric is needed")
+    n = np.asarray(modes, dtype=float)
+    if axes is None:
+        ncols = 2 if len(names) > 1 else 1
+        nrows = math.ceil(len(names) / ncols)
+        width = figure_size(size)[0]
+        fig, grid = _new_figure((width, 0.32 * width * nrows + 0.5), nrows, ncols, sharex=True)
+        axes = list(np.atleast_1d(grid).ravel())
+        for extra in axes[len(names):]:
+            extra.set_visible(False)
+        axes = axes[: len(names)]
+    else:
+        axes = list(axes)
+        if len(axes) < len(names):
+            raise ParameterError(f"axes: {len(axes)} axes for {len(names)} metrics")
+        fig = axes[0].figure
+    labels = dict(metric_labels or {})
+    lines = []
+    for a, name in zip(axes, names):
+        v = np.array([np.nan if x is None else float(x) for x in values[name]])
+        e = np.array([np.nan if x is None else float(x) for x in estimates.get(name, [None] * n.size)])
+        if v.shape != n.shape or e.shape != n.shape:
+            raise ParameterError(f"values.{name}: {v.size} values and {e.size} estimates for {n.size} mode counts")
+        ref = v[-1]
+        change = np.abs(v - ref) / abs(ref) if np.isfinite(ref) and ref != 0 else np.full_like(v, np.nan)
+        change[-1] = np.nan
+        ok_e = np.isfinite(e) & (e > 0)
+        ok_c = np.isfinite(change) & (change > 0)
+        lines.extend(a.plot(n[ok_e], e[ok_e], marker="o", ms=3.5, lw=1.0, color="#000000", label="estimate"))
+        lines.extend(a.plot(n[ok_c], change[ok_c], marker="s", ms=3.5, lw=0.9, ls=":", color="#0072B2",
+                            mfc="none", label=f"change from N = {int(n[-1])}"))
+        if tolerance is not None:
+            lines.append(a.axhline(tolerance, color="0.45", ls="--", lw=0.8, label="solver.tolerance"))
+        a.set_xscale("log", base=2)
+        shown = np.concatenate([e[ok_e], change[ok_c], [] if tolerance is None else [tolerance]])
+        a.set_yscale("log")
+        _decade_ticks(a.yaxis, float(shown.min(initial=1.0)), float(shown.max(initial=1.0)))
+        if not (ok_e.any() or ok_c.any()):
+            a.text(0.5, 0.5, "zero at every count", transform=a.transAxes, ha="center", va="center")
+        a.set_xticks(n, [str(int(k)) for k in n])
+        a.xaxis.set_minor_locator(require("matplotlib.ticker", "plot").NullLocator())
+        a.set_title(labels.get(name, name), fontsize="medium")
+        a.set_ylabel("relative [-]")
+        a.grid(True, which="both", alpha=0.3)
+    for a in axes[-2:]:
+        a.set_xlabel("modes per state N [-]")
+    if title:
+        fig.suptitle(title)
+    leg = _outside_legend(fig, axes[0], ncols=3)
+    return _finish(PlotHandles(fig, tuple(axes), tuple(lines), {"legend": leg}), path, dpi)
+
+
+def _decade_ticks(axis, lo: float, hi: float) -> None:
+    """Log ticks at 1, 2, 5 per decade over a short range, at decades (every k-th) over a long one."""
+    decades = math.log10(hi / lo) if lo > 0 else 0.0
+    if decades <= 3.0:
+        _log_ticks(axis)
+        return
+    ticker = require("matplotlib.ticker", "plot")
+    step = max(1, math.ceil(decades / 5))
+    axis.set_major_locator(ticker.LogLocator(base=10.0 ** step, numticks=12))
+    axis.set_major_formatter(ticker.LogFormatterSciNotation(base=10.0))
+    axis.set_minor_locator(ticker.NullLocator())

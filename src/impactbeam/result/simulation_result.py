@@ -123,47 +123,79 @@ class SimulationResult:
 
             key, change = worst(conv)
             out += (
-                f"not converged in the number of modes: with {self.n_modes} modes {key} still changes by "
+                f"not converged in the number of modes: with {self.n_modes} modes the estimated error of {key} is "
                 f"{change:.2g} (relative; solver.tolerance = {self.tolerance:g}); use more modes or "
                 'solver.modes = "auto"',
             )
         return out
 
     # ------------------------------------------------------------------ convergence in the modes
-    def set_convergence(self, changes: dict[str, float]) -> None:
-        """Record the relative change of the metrics against a smaller mode count.
+    def set_convergence(self, changes: dict[str, float], peak_forces: Any = None, counts: tuple[int, ...] = ()) -> None:
+        """Record the error estimate of the metrics (and of the impacts' peak forces) from runs with fewer modes.
 
         Parameters
         ----------
         changes : dict of str -> float
-            Metric name -> relative change (see :attr:`convergence`).
+            Metric name -> estimated relative error (see :attr:`convergence`).
+        peak_forces : array_like, (n_impacts,), optional
+            Estimated relative error of each impact's peak force (see :attr:`impact_convergence`).
+        counts : tuple of int
+            The mode counts the estimate compared with.
         """
         self.__dict__["_convergence"] = dict(changes)
+        self.__dict__["_impact_convergence"] = None if peak_forces is None else np.asarray(peak_forces, dtype=float)
+        self.__dict__["_convergence_counts"] = tuple(int(c) for c in counts)
+
+    def _estimate(self) -> None:
+        """Run the coarser counts and record the estimate (:mod:`impactbeam.solver.convergence`)."""
+        from ..solver.convergence import coarser_counts, estimate
+
+        counts = coarser_counts(self.n_modes)
+        coarse = [self.rerun(c).metrics() for c in counts]  # type: ignore[misc]
+        metrics, peaks = estimate(self.metrics(), coarse)
+        self.set_convergence(metrics, peaks, counts)
 
     @property
     def convergence(self) -> dict[str, float] | None:
-        """Relative change of each Table-2 metric against a run with fewer modes.
+        """Estimated relative error of each Table-2 metric (modal truncation).
 
-        For ``solver.modes = "auto"`` the change between the last two counts;
-        for a fixed count ``n`` computed on first access by a second run with
-        ``n - max(2, n // 4)`` modes (see :mod:`impactbeam.solver.convergence`).
-        None when it cannot be computed (one mode).
+        The largest change against two runs with fewer modes (about ``n / 2``
+        and ``3 n / 4``: :func:`~impactbeam.solver.convergence.coarser_counts`,
+        :attr:`convergence_counts`), computed on first access (with
+        ``solver.modes = "auto"``, during the search); what it guarantees and
+        where it does not: :mod:`impactbeam.solver.convergence`.
+        None when it cannot be computed (one mode, or a result without a re-run).
         """
         if "_convergence" not in self.__dict__:
             from .._warnings import emit_user_level_warning as warn
-            from ..solver.convergence import coarser_count, relative_changes
 
             if self.rerun is None or self.n_modes <= 1:
                 return None
-            coarse = self.rerun(coarser_count(self.n_modes))
-            self.set_convergence(relative_changes(self.metrics(impacts=False), coarse.metrics(impacts=False)))
+            self._estimate()
             if not self.converged:
                 warn(self.warnings[-1])
         return self.__dict__["_convergence"]
 
     @property
+    def impact_convergence(self) -> np.ndarray | None:
+        """Estimated relative error of each impact's peak force, one per row of :attr:`impacts`.
+
+        1 for an impact that has no overlapping impact in a coarser run (it
+        may not exist in the converged answer); see :attr:`convergence`.
+        """
+        if self.convergence is None:
+            return None
+        return self.__dict__.get("_impact_convergence")
+
+    @property
+    def convergence_counts(self) -> tuple[int, ...]:
+        """The mode counts the estimate of :attr:`convergence` compared with."""
+        self.convergence  # noqa: B018 - computes it
+        return self.__dict__.get("_convergence_counts", ())
+
+    @property
     def converged(self) -> bool:
-        """True when every convergence metric changes by less than ``solver.tolerance``."""
+        """True when every Table-2 metric's estimated error is below ``solver.tolerance``."""
         conv = self.convergence
         return conv is not None and max(conv.values()) < self.tolerance
 

@@ -19,19 +19,20 @@ Here all states are integrated in ONE basis of ``N + n_r`` functions
   code_aster's static enrichment (MODE_STAT/MODE_CORR) and the MacNeal-Craig
   residual-flexibility method. ``r_a`` is mass- and stiffness-orthogonal to
   every retained mode; the ``r_a`` are mass-orthonormalised among themselves
-  and diagonalise the free stiffness (pseudo-frequencies above ``omega_N``).
+  (through their singular directions, so no round-off tie chooses a column)
+  and diagonalise the free stiffness (pseudo-frequencies above ``omega_N``);
+  their mass and strain energy come from one quadrature, so they are those of
+  the functions as evaluated;
 
-* when these do not give the first ``N`` frequencies of the state with every
-  contactor engaged to ``1e-4`` (a stop much stiffer than the beam there,
-  e.g. at a free end: those modes reach above the retained band), that
-  state's first ``N`` exact modes ``psi_j`` as well, each through its part
-  outside the retained modes, ``psi_j - sum_i P_ij phi_i`` with
-  ``P = <phi, psi>`` (paper eq. 12). Every state's lowest ``N`` modes are then
-  in the basis, as in the paper's method, which keeps ``N`` per state. Their
-  free stiffness follows from modal identities, ``K psi = K_s psi - sum k
-  psi(a) delta_a``. A direction with less than 1e-3 of its norm outside the
-  others is left out (it would amplify round-off); supported beams only (the
-  free state has no rigid-body mode).
+* for stiff stops (:mod:`~impactbeam.solver.ritz_enrich`): the engaged
+  state's lowest ``N`` modes where they have more than 1e-3 of their norm
+  outside the basis (a stop at a free end pins it), the stop's local shapes
+  at the frequencies of its impact (``k = 1e7`` N/m on the paper's specimen
+  loads the beam within 2 us), and the second load-dependent Ritz vector of a
+  point force at a stop. Every state's lowest ``N`` modes are then in the
+  basis, as in the paper's method. Soft contactors (the paper's cases) keep
+  ``N + 1`` functions; supported beams only (the free state has no
+  rigid-body mode).
 
 In that basis (mass matrix the identity) the stiffness of every state is exact
 in the reduced coordinates,
@@ -78,18 +79,17 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
-import scipy.linalg
 
 from ..model.beam import Beam
 from ..modal import ModeSet, mode_set, static_coefficients, static_state
+from .ritz_enrich import Enrichment, enrich
 
 __all__ = ["RitzBasis", "ritz_basis"]
 
 _MERGE = 3e-5  # contactors closer than this fraction of L share one attachment shape
 _DROP = 1e-11  # a residual shape smaller than this fraction of its static shape is dropped
 _LOSSY = 1e-12  # below this fraction the residual keeps fewer than ~4 digits (cancellation): warn
-_NEW = 1e-3  # a contact-state mode must bring at least this fraction of its norm outside the basis
-_UNION = 1e-4  # the engaged state's first N frequencies must come out this close, else its modes join
+_NEW = 1e-3  # an attachment direction below this fraction of the largest is dropped
 _GX, _GW = np.polynomial.legendre.leggauss(20)
 
 
@@ -125,7 +125,7 @@ class RitzBasis:
     """
 
     def __init__(self, beam: Beam, positions: Sequence[float], n_modes: int,
-                 contact: Sequence[tuple[float, float]] = ()) -> None:
+                 contact: Sequence[tuple[float, float]] = (), loads: Sequence[float] = ()) -> None:
         self.beam = beam
         self.free = mode_set(beam, (), n_modes)
         L = beam.length
@@ -134,30 +134,64 @@ class RitzBasis:
             if not pos or a - pos[-1] > _MERGE * L:
                 pos.append(a)
         self._alpha = np.array(pos) / L
-        self._contact: ModeSet | None = None
-        # the engaged state's modes may join (supported beams only: with rigid-body modes the
-        # inertia-relief attachment shapes are not K-orthogonal to them in the same sense)
-        engaged = mode_set(beam, contact, n_modes) if contact and pos and not self.free.n_rigid else None
-        self._x, self._w = self._quadrature(engaged)
+        self._x, self._w = self._quadrature()
         self._keep_attachments()
         self.positions = self._alpha * L
-        self._P = np.zeros((self.free.count, 0))
         self._C = np.zeros((self.free.count, 0))
         lr = np.zeros(0)
         self._Z = np.zeros((0, 0))
+        self.enrichment: Enrichment | None = None
         if self._alpha.size:
-            lr = self._orthonormalise(())
-            if engaged is not None and self._misses_contact_modes(lr, contact, engaged):
-                self._contact = engaged
-                self._P = self.free.overlap(engaged)
-                self._C = np.zeros((self.free.count, 0))
-                lr = self._orthonormalise(contact)
+            lr = self._orthonormalise()
+            # stiff stops get the engaged state's modes and their local shapes (supported beams only:
+            # with rigid-body modes the inertia-relief attachment shapes obey another identity)
+            if contact and not self.free.n_rigid:
+                self.enrichment = enrich(beam, self.free, self.positions, self._Z, self._rho_at,
+                                         self._samples, contact, loads)
+                if self.enrichment is not None:
+                    lr = self.enrichment.lam
         self.lam = np.concatenate([self.free.omega**2, lr])
         self.count = int(self.lam.size)
-        self.integral = (self.values(self._x) @ self._w)
+        self.integral = self._integral()
         self.integral.setflags(write=False)
-        self.inertia = self._sample(self.values, rows="translation").T @ self._sample_weights()
+        self.inertia = self._inertia()
         self.inertia.setflags(write=False)
+
+    @property
+    def roundoff(self) -> float:
+        """Relative round-off of the basis functions' values and of their mass and stiffness (an estimate).
+
+        The attachment residual ``r = g - sum phi_i phi_i(a) / omega_i^2`` is a
+        difference of O(1) shapes: its values keep the round-off of the ``N``
+        terms (a few ulps each) times ``|g| / |r|``, and its stiffness ``r(a)``
+        that of ``g(a)`` times ``g(a) / r(a)`` (both grow as ``N^3`` to
+        ``N^3.5``); an extra function of the enrichment combines the residual
+        functions with coefficients up to ``|A_rho|_1`` (its part beyond the
+        reference modes, divided by that part's small norm). So ``4 N eps
+        max(|g| / |r|, g(a) / r(a)) max(1, |A_rho|_1)``: an independent
+        quadrature finds the mass matrix within this of the identity and the
+        stiffness within this times the largest ``lambda`` (tests/test_ritz.py).
+        """
+        enr = self.enrichment
+        amp = 1.0 if enr is None else max(1.0, float(np.abs(enr.A_rho).sum(axis=0).max()))
+        return float(4 * self.free.count * np.finfo(float).eps * getattr(self, "_cancellation", 1.0) * amp)
+
+    def _integral(self) -> np.ndarray:
+        """``int_0^L f dx`` of every basis function."""
+        enr = self.enrichment
+        if enr is None:
+            return self.values(self._x) @ self._w
+        rho = self._rho_at(self._x, 0) @ self._w
+        return np.concatenate([self.free.integral(), enr.values(rho, enr.modes.integral()[enr.n_retained:])])
+
+    def _inertia(self) -> np.ndarray:
+        """``int rho A f dx + sum m f(x_m)`` of every basis function (the load of a base acceleration)."""
+        enr = self.enrichment
+        if enr is None:
+            return self._sample(self.values, rows="translation").T @ self._sample_weights()
+        rho = self._sample(self._rho_at, rows="translation").T @ self._sample_weights()
+        tail = enr.modes.inertia_integral()[enr.n_retained:]
+        return np.concatenate([self.free.inertia_integral(), enr.values(rho, tail)])
 
     def _sample_weights(self) -> np.ndarray:
         """``sqrt`` of the translational kinetic weights of :meth:`_sample` (quadrature and point masses)."""
@@ -165,24 +199,63 @@ class RitzBasis:
         at = lay.m > 0.0
         return np.concatenate([np.sqrt(self.beam.mass_per_length_at(self._x) * self._w), np.sqrt(lay.m[at])])
 
-    def _sample(self, fn, rows: str = "all") -> np.ndarray:
+    def _sample(self, fn, rows: str = "all", quadrature: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """Functions ``fn(x, field)`` weighted so that ``S^T S`` is their kinetic inner product: (rows, n).
 
-        Rows: the quadrature with ``rho A(x) w``, the point masses with ``m``;
-        then (``rows="all"``) the rotations, with ``rho I(x) w`` for a
-        Timoshenko beam and ``J`` at the point masses.
+        Rows: the quadrature (``quadrature``, default the basis's) with
+        ``rho A(x) w``, the point masses with ``m``; then (``rows="all"``) the
+        rotations, with ``rho I(x) w`` for a Timoshenko beam and ``J`` at the
+        point masses.
         """
         lay = self.free._layout
         at, atJ = lay.m > 0.0, lay.J > 0.0
-        parts = [(fn(self._x, 0) * np.sqrt(self.beam.mass_per_length_at(self._x) * self._w)).T]
+        x, w = (self._x, self._w) if quadrature is None else quadrature
+        parts = [(fn(x, 0) * np.sqrt(self.beam.mass_per_length_at(x) * w)).T]
         if at.any():
             parts.append((fn(lay.nodes[at], 0) * np.sqrt(lay.m[at])).T)
         if rows == "all":
             if self.beam.is_timoshenko:
-                parts.append((fn(self._x, "rot") * np.sqrt(self.beam.rotary_inertia_at(self._x) * self._w)).T)
+                parts.append((fn(x, "rot") * np.sqrt(self.beam.rotary_inertia_at(x) * w)).T)
             if atJ.any():
                 parts.append((fn(lay.nodes[atJ], "rot") * np.sqrt(lay.J[atJ])).T)
         return np.concatenate(parts)
+
+    def _gram(self, fn, bmax: float) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic and strain-energy inner products of the functions ``fn(x, field)`` (see :meth:`_samples`)."""
+        S, E = self._samples(fn, bmax)
+        assert E is not None
+        return S.T @ S, E.T @ E
+
+    def _samples(self, fn, bmax: float, strain: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """Weighted samples ``(S, E)`` of the functions ``fn(x, field)``: ``S^T S`` and ``E^T E`` are their inner products.
+
+        On a quadrature resolving the wavenumber ``bmax`` (split at the
+        contactors and every node of the beam): the kinetic ``int rho A f g``
+        (and the rotary terms, the point masses) and the strain energy
+        ``int M_f M_g / EI`` (plus ``int kappa G A (f' - Psi_f)(g' - Psi_g)``
+        for a Timoshenko beam) with the finite translational and rotational
+        springs of the supports (``E`` is None without ``strain``). Linear in
+        the functions, so the samples of a combination are the combination of
+        the samples.
+        """
+        quad = self._quadrature(bmax)
+        S = self._sample(fn, quadrature=quad)
+        if not strain:
+            return S, None
+        x, w = quad
+        beam = self.beam
+        parts = [(fn(x, "moment") * np.sqrt(w / beam.bending_stiffness_at(x))).T]
+        if beam.is_timoshenko:
+            pieces = beam.pieces()
+            ends = np.cumsum([p.length for p in pieces])[:-1]
+            GA = np.array([beam.shear_stiffness(p) for p in pieces])[np.searchsorted(ends, x, side="right")]
+            parts.append(((fn(x, 1) - fn(x, "rot")) * np.sqrt(w * GA)).T)
+        lay = self.free._layout
+        for xs, k, kt in zip(lay.nodes, lay.k, lay.kt):
+            for value, field in ((k, 0), (kt, "rot")):
+                if 0.0 < value < math.inf:
+                    parts.append(math.sqrt(value) * fn(np.array([xs]), field).T)
+        return S, np.concatenate(parts)
 
     def _free_at(self, x: np.ndarray, field: int | str) -> np.ndarray:
         return _mode_field(self.free, x, field)
@@ -201,6 +274,16 @@ class RitzBasis:
         g_norm = np.linalg.norm(self._sample(self._static_at), axis=0)
         r_norm = np.linalg.norm(Rq, axis=0)
         keep = r_norm > _DROP * g_norm
+        # the residual r = g - (its part in the retained modes) is a difference: its values carry the
+        # round-off of g's times |g| / |r|, and its stiffness matrix r_c(a_d) that of g_c(a_d) over the
+        # smallest eigenvalue of r_c(a_d)
+        at = self._alpha[keep] * L
+        if at.size:
+            Ga = self._static_at(at, 0)[keep]
+            Ra = self._residuals_at(at, 0)[keep]
+            smallest = float(np.linalg.eigvalsh(0.5 * (Ra + Ra.T)).min())
+            stiff = float(np.abs(Ga).max()) / smallest if smallest > 0 else math.inf
+            self._cancellation = float(max(np.max(g_norm[keep] / r_norm[keep]), stiff))
         lossy = keep & (r_norm < _LOSSY * g_norm)
         if lossy.any():
             warnings.warn(
@@ -215,61 +298,29 @@ class RitzBasis:
             for name in ("_static", "_static_q", "_modal_static"):
                 self.__dict__.pop(name, None)
 
-    def _misses_contact_modes(self, lr: np.ndarray, contact: Sequence[tuple[float, float]], engaged: ModeSet) -> bool:
-        """Whether this basis gives the first N frequencies of the ``engaged`` state worse than ``_UNION``.
-
-        Rayleigh-Ritz in the basis (free modes, attachment shapes) against the
-        exact modes of the state with every ``contact`` spring engaged.
-        """
-        lam = np.concatenate([self.free.omega**2, lr])
-        xs = [x for x, _ in contact]
-        at = np.concatenate([self.free.shapes(xs), self._Z.T @ self._extra_at(np.asarray(xs, dtype=float), 0)])
-        K = np.diag(lam) + sum(k * np.outer(at[:, j], at[:, j]) for j, (_, k) in enumerate(contact))
-        exact = engaged.omega
-        ritz = np.sqrt(np.maximum(np.linalg.eigvalsh(0.5 * (K + K.T)), 0.0))[: exact.size]
-        scale = max(float(exact.max(initial=0.0)), 1e-300)
-        return bool(np.max(np.abs(ritz - exact[: ritz.size]) / np.maximum(exact[: ritz.size], 1e-9 * scale)) > _UNION)
-
     def _extra_at(self, x: np.ndarray, derivative: int | str) -> np.ndarray:
-        """The residual functions before orthonormalisation: attachment shapes, then ``psi_j - sum_i P_ij phi_i``."""
+        """The attachment residuals before orthonormalisation, cleared of round-off along the retained modes."""
         R = self._residuals_at(x, derivative)
-        if self._contact is not None:
-            F = self._free_at(x, derivative)
-            R = np.concatenate([R, _mode_field(self._contact, x, derivative) - self._P.T @ F])
         if self._C.shape[1]:
             R = R - self._C.T @ self._free_at(x, derivative)
         return R
 
-    def _extra_stiffness(self, contact: Sequence[tuple[float, float]]) -> np.ndarray:
-        """Free-state stiffness ``<f, K f>`` of the residual functions, exact from the modal data.
+    def _rho_at(self, x: np.ndarray, derivative: int | str) -> np.ndarray:
+        """The plain basis's residual functions ``rho_j = sum_c Z[c, j] r_c`` at ``x``: (n_r, p)."""
+        return self._Z.T @ self._extra_at(np.atleast_1d(np.asarray(x, dtype=float)), derivative)
 
-        ``r_c^T K r_d = r_c(a_d)``; with the contact-state modes ``psi`` (springs
-        ``k_s`` at ``a_s`` engaged), ``K psi = K_s psi - sum_s k_s psi(a_s) delta_s``:
-        ``psi~^T K psi~ = Omega_c^2 - sum_s k_s psi(a_s) psi(a_s)^T - P^T Omega^2 P`` and
-        ``r_c^T K psi~ = psi(a_c) - P^T phi(a_c)``. Every residual function is
-        K-orthogonal to the retained modes.
-        """
-        Ra = self._residuals_at(self.positions, 0)
-        K = 0.5 * (Ra + Ra.T)
-        if self._contact is None:
-            return K
-        cm, P = self._contact, self._P
-        xs = np.array([x for x, _ in contact], dtype=float)
-        ks = np.array([k for _, k in contact], dtype=float)
-        psa = cm.shapes(xs)
-        Kpp = np.diag(cm.omega**2) - (psa * ks) @ psa.T - P.T @ (self.free.omega[:, None] ** 2 * P)
-        K1p = (cm.shapes(self.positions) - P.T @ self.free.shapes(self.positions)).T
-        return np.block([[K, K1p], [K1p.T, 0.5 * (Kpp + Kpp.T)]])
-
-    def _orthonormalise(self, contact: Sequence[tuple[float, float]]) -> np.ndarray:
+    def _orthonormalise(self) -> np.ndarray:
         """Mass-orthonormal residual functions that diagonalise the free stiffness; returns their ``lambda_r``.
 
-        On the quadrature the weighted functions are projected out of the
-        retained modes twice (classical Gram-Schmidt; the coefficients are kept
-        in ``_C``), then orthonormalised by a column-pivoted QR; a direction
-        whose part outside the earlier ones is below ``_NEW`` of its norm (a
-        contact-state mode the free modes already hold) is dropped, so no
-        combination amplifies round-off by more than ``1 / _NEW``.
+        On the quadrature the weighted attachment residuals are projected out
+        of the retained modes twice (classical Gram-Schmidt; the coefficients
+        are kept in ``_C``) and orthonormalised through their singular
+        directions (no column is preferred, so round-off cannot pick one); a
+        direction below ``_NEW`` of the largest is dropped. Their free
+        stiffness is the strain energy on the same quadrature, so mass and
+        stiffness are those of the functions as evaluated (the identity
+        ``r_c^T K r_d = r_c(a_d)`` from ``K g_a = delta_a`` would carry the
+        round-off of ``g(a)`` times ``g(a) / r(a)``, 1e-11 at 8 modes).
         """
         F = self._sample(self._free_at)  # (rows, N), orthonormal columns
         B = self._sample(self._extra_at)
@@ -279,31 +330,22 @@ class RitzBasis:
             B = B - F @ c
             C += c
         self._C = C
-        norm = np.linalg.norm(B, axis=0)
-        n_a = self._alpha.size
-        # a contact-state mode (unit norm) that the free modes hold to _NEW (one the
-        # springs do not move, e.g. antisymmetric about a stop) is left out: what remains
-        # of it is round-off
-        cols = np.flatnonzero((np.arange(B.shape[1]) < n_a) | (norm > _NEW))
-        d = 1.0 / norm[cols]
-        _, Rt, piv = scipy.linalg.qr(B[:, cols] * d, mode="economic", pivoting=True)
-        k = int(np.sum(np.abs(np.diag(Rt)) > _NEW))
-        Y = np.zeros((B.shape[1], k))
-        Y[cols[piv[:k]]] = d[piv[:k], None] * np.linalg.inv(Rt[:k, :k])
-        K = self._extra_stiffness(contact) + C.T @ (self.free.omega[:, None] ** 2 * C)
+        d = 1.0 / np.linalg.norm(B, axis=0)
+        _, s, Vt = np.linalg.svd(B * d, full_matrices=False)
+        k = int(np.sum(s > _NEW * s[0]))
+        Y = d[:, None] * (Vt[:k].T / s[:k])
+        _, K = self._gram(self._extra_at, 0.0)
         lr, V = np.linalg.eigh(Y.T @ K @ Y)
         self._Z = Y @ V
         return lr
 
-    def _quadrature(self, engaged: ModeSet | None) -> tuple[np.ndarray, np.ndarray]:
-        """Gauss-Legendre (20 points) on pieces of at most half the shortest retained wavelength, split at the contactors.
+    def _quadrature(self, bmax: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Legendre (20 points) on pieces of at most half the shortest wavelength, split at the contactors.
 
-        The wavelengths are those of the free modes and of the ``engaged`` state's modes.
+        The wavelength is that of the retained modes, or of the wavenumber ``bmax`` when larger.
         """
         L = self.beam.length
-        bmax = max(float(self.free._beta_max), 4.0 / L)
-        if engaged is not None:
-            bmax = max(bmax, float(engaged._beta_max))
+        bmax = max(float(self.free._beta_max), 4.0 / L, bmax)
         breaks = np.unique(np.concatenate([[0.0, L], self._alpha * L, self.free.nodes]))
         xs, ws = [], []
         for a, b in zip(breaks[:-1], breaks[1:]):
@@ -409,20 +451,38 @@ class RitzBasis:
         """
         x = np.atleast_1d(np.asarray(x, dtype=float))
         out = self._free_at(x, derivative)
-        if self._Z.size:
-            out = np.concatenate([out, self._Z.T @ self._extra_at(x, derivative)])
+        enr = self.enrichment
+        if enr is not None:
+            tail = _mode_field(enr.modes, x, derivative)[enr.n_retained:]
+            out = np.concatenate([out, enr.values(self._rho_at(x, derivative), tail)])
+        elif self._Z.size:
+            out = np.concatenate([out, self._rho_at(x, derivative)])
         return out
 
 
 @functools.lru_cache(maxsize=64)
 def _cached_basis(beam: Beam, positions: tuple[float, ...], n_modes: int,
-                  contact: tuple[tuple[float, float], ...]) -> RitzBasis:
-    return RitzBasis(beam, positions, n_modes, contact)
+                  contact: tuple[tuple[float, float], ...], loads: tuple[float, ...]) -> RitzBasis:
+    return RitzBasis(beam, positions, n_modes, contact, loads)
 
 
 def ritz_basis(beam: Beam, positions: Sequence[float], n_modes: int,
-               contact: Sequence[tuple[float, float]] = ()) -> RitzBasis:
-    """The shared basis of ``n_modes`` free modes, the attachment shapes at ``positions`` and (with
-    ``contact``, the engaged springs as (position, stiffness)) that contact state's modes (cached)."""
+               contact: Sequence[tuple[float, float]] = (), loads: Sequence[float] = ()) -> RitzBasis:
+    """The shared basis (cached).
+
+    Parameters
+    ----------
+    beam : Beam
+    positions : sequence of float, [m]
+        Contactor positions: one attachment shape each.
+    n_modes : int
+        Retained free modes ``N``.
+    contact : sequence of (position [m], stiffness [N/m])
+        The contactors, all engaged: that state's modes and the stops' local
+        shapes join the basis where it misses them (:mod:`~impactbeam.solver.ritz_enrich`).
+    loads : sequence of float, [m]
+        Positions of point forces (their second load-dependent Ritz vector joins at a stop).
+    """
     key = tuple(sorted((float(x), float(k)) for x, k in contact))
-    return _cached_basis(beam, tuple(sorted(float(p) for p in positions)), int(n_modes), key)
+    return _cached_basis(beam, tuple(sorted(float(p) for p in positions)), int(n_modes), key,
+                         tuple(sorted(float(x) for x in loads)))

@@ -153,7 +153,9 @@ class RitzStateSpace(ProblemSpace):
                     f"contactors.{i}.stiffness: a rigid stop cannot be integrated in the enriched basis "
                     "(solver.basis); give a finite stiffness"
                 )
-        self.basis = ritz_basis(beam, self.positions, n_modes, [(c.position, c.stiffness) for c in self.contactors])
+        loads = [excitation.position] if excitation.kind == "point_force" and excitation.position is not None else []
+        self.basis = ritz_basis(beam, self.positions, n_modes, [(c.position, c.stiffness) for c in self.contactors],
+                                loads)
         self._psi_c = self.basis.values(self.positions) if self.contactors else np.zeros((self.basis.count, 0))
         self._psi_o = self.basis.values(self.points) if self.points.size else np.zeros((self.basis.count, 0))
         self._p = spatial_projection(excitation, self.basis.values, self.basis.integral, beam.mass_per_length,
