@@ -79,18 +79,15 @@ def simulate(
     metrics = result.metrics()
     metrics["modes"] = result.n_modes
     metrics["convergence"] = result.convergence  # computed now, so its warning is caught below
+    # a write that fails (read-only or full file system) ends in one line naming the option (handle_errors)
     if out is not None:
         try:
             write_result(result, out)
-        except OSError as exc:
-            fail(f'--out: cannot write "{out}": {exc.strerror or exc}', 1)
         except ImportError as exc:  # an optional writer backend is missing
             fail(f'--out: cannot write "{out}": {exc}', 1)
     if plot is not None:
         try:
             plot_result(result, plot, excitation=sc.excitation)
-        except OSError as exc:
-            fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:
             fail(f'--plot: cannot write "{plot}": {exc}', 1)
     caught = take_warnings()
