@@ -64,7 +64,8 @@ class Excitation:
     frequency : float or None, [Hz]
         Forcing frequency ``f`` (harmonic only).
     phase : float, [rad]
-        Phase of the harmonic load at ``start`` (harmonic only).
+        Phase of the harmonic load at ``start`` (harmonic only); a phase
+        outside [-2 pi, 2 pi] is reduced to (-pi, pi] (the same sinusoid).
     """
 
     kind: ExcitationKind = "none"
@@ -87,7 +88,7 @@ class Excitation:
         object.__setattr__(self, "amplitude", finite("excitation.amplitude", self.amplitude))
         object.__setattr__(self, "start", nonnegative_finite("excitation.start", self.start))
         object.__setattr__(self, "scale", finite("excitation.scale", self.scale))
-        object.__setattr__(self, "phase", finite("excitation.phase", self.phase))
+        object.__setattr__(self, "phase", _reduced_angle(finite("excitation.phase", self.phase)))
         if self.kind == "none":
             return
         if self.shape == "half_sine":
@@ -173,6 +174,19 @@ class Excitation:
                 idx = np.clip(np.searchsorted(tk, tau[inside], side="right") - 1, 0, tk.size - 1)
                 out[inside] = vk[idx]
         return self.scale * out
+
+
+def _reduced_angle(phase: float) -> float:
+    """``phase`` [rad] reduced to (-pi, pi] when it lies outside [-2 pi, 2 pi].
+
+    ``sin(Omega tau + phase)`` with a phase of 1e20 rad would lose ``Omega tau``
+    entirely in the sum (the spacing of doubles near 1e20 is 16384); the
+    reduction goes through :func:`math.sin` and :func:`math.cos`, whose
+    argument reduction is exact, so the load is the same sinusoid.
+    """
+    if abs(phase) <= 2.0 * math.pi:
+        return phase
+    return math.atan2(math.sin(phase), math.cos(phase))
 
 
 @dataclass(frozen=True, eq=False)
