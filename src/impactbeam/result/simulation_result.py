@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._io import RESULT_SUFFIXES, atomic_path
+from .._io import RESULT_SUFFIXES, atomic_path, write_netcdf
 from .._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
 from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
@@ -23,8 +23,11 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SimulationResult", "write_result", "RESULT_SUFFIXES", "sample_count", "memory_limit", "check_memory", "output_bytes",
-    "check_output_size",
+    "check_output_size", "STRESS_METRIC_UNITS",
 ]
+
+#: Units of the metrics that ``[output] fields = ["stress"]`` adds to :meth:`SimulationResult.metrics`.
+STRESS_METRIC_UNITS = {"max_bending_stress": "Pa", "max_bending_stress_time": "s", "max_bending_stress_position": "m"}
 
 _CHUNK = 65536  # samples evaluated per call of the compiled sampler
 
@@ -375,6 +378,7 @@ class SimulationResult:
         """
         from .stress import bending_moment
 
+        self._require_exact("bending_moment")
         return bending_moment(self, points, times, static_correction=static_correction)
 
     def bending_stress(self, points: Any, times: Any, *, static_correction: bool = True) -> np.ndarray:
@@ -395,7 +399,26 @@ class SimulationResult:
         """
         from .stress import bending_stress
 
+        self._require_exact("bending_stress")
         return bending_stress(self, points, times, static_correction=static_correction)
+
+    def _require_exact(self, what: str) -> None:
+        """ParameterError for a moment or stress of a ``method = "ivp"`` run (its solution has no state space)."""
+        if self.options.get("method", "exact") != "exact":
+            raise ParameterError(
+                f'{what}: moments and stresses come from the exact solution; this result was computed with '
+                f'method = "{self.options.get("method")}" (the reference path): run simulate(..., method="exact")'
+            )
+
+    @functools.cached_property
+    def _field_grid(self) -> dict[str, np.ndarray]:
+        """The ``[output] fields`` beyond w and w_t on the output grid: ``moment`` [N m], ``stress`` [Pa], (n_t, n_p)."""
+        out = {}
+        if "moment" in self.fields:
+            out["moment"] = self.bending_moment(self.points, self.time).T
+        if "stress" in self.fields:
+            out["stress"] = self.bending_stress(self.points, self.time).T
+        return out
 
     def final_state(self) -> ModalState:
         """The modal state at the end of the run, to start another from (``simulate(..., start=)``).
@@ -425,6 +448,7 @@ class SimulationResult:
 
         out = compute_metrics(self, impacts=impacts)
         if "stress" in self.fields:
+            self._require_exact("max_bending_stress")
             from .stress import max_bending_stress
 
             value, when, where = max_bending_stress(self)
@@ -466,7 +490,8 @@ class SimulationResult:
         return result_dataset(self)
 
     def to_dataframe(self):
-        """Wide table: time, w and w_t at each point, contact force per contactor, energies."""
+        """Wide table: time, w and w_t at each point, contact force per contactor, energies, and the
+        bending moment ``M`` and stress ``sigma`` at each point when ``[output] fields`` asks for them."""
         import pandas as pd
 
         cols: dict[str, np.ndarray] = {"time [s]": self.time}
@@ -479,6 +504,9 @@ class SimulationResult:
             cols[f"engaged_{i}"] = self.engaged[:, i]
         for name, arr in self.energy.items():
             cols[f"energy_{name} [J]"] = arr
+        for name, (label, unit) in (("moment", ("M", "N m")), ("stress", ("sigma", "Pa"))):
+            for j, x in enumerate(self.points if name in self._field_grid else ()):
+                cols[f"{label}(x={x:.6g}) [{unit}]"] = self._field_grid[name][:, j]
         return pd.DataFrame(cols)
 
     def plot(self, path: str | os.PathLike | None = None, **kwargs):
@@ -519,6 +547,8 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
         An unsupported suffix.
     ResourceError
         The sampled histories would exceed the memory limit.
+    WriteError
+        The file could not be written (a read-only or full file system): nothing is left behind.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -529,11 +559,13 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
     path.parent.mkdir(parents=True, exist_ok=True)
     check_output_size(result.time.size, result.points.size, len(result.contactors), result.solution.n_modes)
+    if suffix == ".nc":
+        write_netcdf(result.to_xarray(), path)
+        return path
+    table = result.to_dataframe()
     with atomic_path(path) as tmp:
-        if suffix == ".nc":
-            result.to_xarray().to_netcdf(tmp, engine="h5netcdf")
-        elif suffix == ".csv":
-            result.to_dataframe().to_csv(tmp, index=False)
+        if suffix == ".csv":
+            table.to_csv(tmp, index=False)
         else:
-            result.to_dataframe().to_parquet(tmp, index=False)
+            table.to_parquet(tmp, index=False)
     return path

@@ -211,5 +211,7 @@ def _parse_contactors(raw: Mapping[str, Any], beam: Beam) -> tuple[Contactor, ..
         gap = _nonnegative(f"{prefix}.gap", c.get("gap", 0.0), "length")
         side = _choice(f"{prefix}.side", c.get("side", "below"), _SIDES)
         with _relabel(prefix, (("contactor.", f"{prefix}."),)):
-            out.append(Contactor(position, stiffness, gap, side))  # type: ignore[arg-type]
+            contactor = Contactor(position, stiffness, gap, side)  # type: ignore[arg-type]
+            contactor.check_on(beam, prefix)
+            out.append(contactor)
     return tuple(out)
