@@ -421,9 +421,11 @@ def rigid_modes(lay: Layout, rotary: float = 0.0) -> np.ndarray:
         rows.append([0.0, 1.0])
     L = lay.nodes[-1]
     if rows:
-        C = np.array(rows)
-        scale = np.array([1.0, L])
-        _, sv, vt = np.linalg.svd(C * scale)
+        # in the dimensionless unknowns (c0, c1 L), each constraint scaled to unit length: the rank
+        # must not depend on the units (with (c0, c1 / L) a beam of 1e-10 m lost its clamp's rotation)
+        scale = np.array([1.0, 1.0 / L])
+        C = np.array(rows) * scale
+        _, sv, vt = np.linalg.svd(C / np.linalg.norm(C, axis=1, keepdims=True))
         rank = int(np.sum(sv > 1e-10 * sv[0]))
         null = (vt[rank:] * scale).T  # (2, r)
     else:

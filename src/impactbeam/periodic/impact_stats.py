@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from ..result import SimulationResult
     from .strobe import SteadyState
 
 __all__ = ["ImpactStatistics", "impact_statistics"]
@@ -54,7 +55,7 @@ class ImpactStatistics:
         Length of the record.
     warnings : list of str
         Those of the steady state (e.g. no period found: the averages are
-        over a record that may not be a steady state).
+        over a record that may not be a steady state) or of the run.
     """
 
     impacts: list[dict[str, Any]] = field(default_factory=list)
@@ -93,23 +94,43 @@ def _quadrature(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a[:, None] + h * u[None, :], h * wu[None, :]
 
 
-def impact_statistics(steady: SteadyState) -> ImpactStatistics:
-    """Per-impact statistics of the recorded steady state (module docstring).
+def _record(run: Any) -> tuple[Any, tuple[float, float], float, list[str]]:
+    """The result, window, forcing period (NaN without one) and warnings of a steady state or a transient."""
+    if hasattr(run, "window") and hasattr(run, "result"):  # a SteadyState
+        return run.result, tuple(run.window), 1.0 / run.frequency, list(run.warnings)
+    if hasattr(run, "solution") and hasattr(run, "contactors") and hasattr(run, "events"):  # a SimulationResult
+        if not hasattr(run.solution, "extrema"):
+            raise TypeError('impact_statistics: the result of method = "ivp" has no exact extrema; '
+                            'simulate with method = "exact"')
+        ex = getattr(getattr(run, "scenario", None), "excitation", None)
+        f = ex.frequency if ex is not None and ex.shape == "harmonic" and ex.frequency else None
+        return run, (0.0, float(run.solution.t_end)), (1.0 / f if f else math.nan), list(run.warnings)
+    raise TypeError(f"impact_statistics: expected a SteadyState or a SimulationResult, got {type(run).__name__}")
+
+
+def impact_statistics(steady: SteadyState | SimulationResult) -> ImpactStatistics:
+    """Per-impact statistics of a recorded steady state or of a whole transient run (module docstring).
 
     Parameters
     ----------
-    steady : SteadyState
-        From :func:`~impactbeam.periodic.strobe.steady_state` or a bifurcation point.
+    steady : SteadyState or SimulationResult
+        From :func:`~impactbeam.periodic.strobe.steady_state` or a bifurcation
+        point (the record window), or from :func:`impactbeam.simulate` (the
+        whole run; ``impacts_per_forcing_period`` is NaN unless the load is
+        harmonic).
 
     Returns
     -------
     ImpactStatistics
+
+    Raises
+    ------
+    TypeError
+        For anything else, or a result of ``method = "ivp"``.
     """
-    res = steady.result
+    res, (lo, hi), T, warnings = _record(steady)
     sol = res.solution
-    lo, hi = steady.window
     duration = hi - lo
-    T = 1.0 / steady.frequency
     impacts: list[dict[str, Any]] = []
     per: list[dict[str, Any]] = []
     for ci, c in enumerate(res.contactors):
@@ -154,4 +175,4 @@ def impact_statistics(steady: SteadyState) -> ImpactStatistics:
             "work_rate": fv / t_contact if t_contact > 0 else math.nan,
         })
     impacts.sort(key=lambda r: (r["start"], r["contactor"]))
-    return ImpactStatistics(impacts, per, duration, list(steady.warnings))
+    return ImpactStatistics(impacts, per, duration, warnings)

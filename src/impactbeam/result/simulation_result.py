@@ -310,7 +310,7 @@ class SimulationResult:
         -------
         ndarray, [m]
         """
-        x = np.atleast_1d(np.asarray(x, dtype=float))
+        x = _one_dimensional("x", x)
         L = self.beam.length
         bad = ~np.isfinite(x) | (x < 0.0) | (x > L * (1.0 + 1e-12))
         if bad.any():
@@ -338,7 +338,7 @@ class SimulationResult:
             A point off the beam or a time outside ``[0, end_time]``.
         """
         x = self.check_points(x)
-        t = self.solution.check_times(t, self.end_time)
+        t = self.solution.check_times(_one_dimensional("t", t), self.end_time)
         return self.solution.sample(x, t).w.T
 
     def velocity(self, x: Any, t: Any) -> np.ndarray:
@@ -357,7 +357,7 @@ class SimulationResult:
             See :meth:`displacement` for NaN and errors.
         """
         x = self.check_points(x)
-        t = self.solution.check_times(t, self.end_time)
+        t = self.solution.check_times(_one_dimensional("t", t), self.end_time)
         return self.solution.sample(x, t).w_t.T
 
     def bending_moment(self, points: Any, times: Any, *, static_correction: bool = True) -> np.ndarray:
@@ -447,6 +447,7 @@ class SimulationResult:
         from .metrics import compute_metrics
 
         out = compute_metrics(self, impacts=impacts)
+        self._warn_unresolved(out)
         if "stress" in self.fields:
             self._require_exact("max_bending_stress")
             from .stress import max_bending_stress
@@ -454,6 +455,22 @@ class SimulationResult:
             value, when, where = max_bending_stress(self)
             out.update(max_bending_stress=value, max_bending_stress_time=when, max_bending_stress_position=where)
         return out
+
+    def _warn_unresolved(self, metrics: dict[str, Any]) -> None:
+        """Warn when the response is too small for the extrema's absolute tolerance (1e-12 of the length)."""
+        peak = max((abs(v) for v in (metrics.get("max_response"), metrics.get("min_response")) if v is not None),
+                   default=0.0)
+        sc = self.scenario
+        driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
+        if driven and peak < 1e-9 * self.beam.length:
+            from .._warnings import emit_user_level_warning
+
+            emit_user_level_warning(
+                f"metrics: the response is only ~{peak:.2g} m, below 1e-9 of the beam length; the extrema behind "
+                f"max_response, t_max and min_response are located to {1e-12 * self.beam.length:.2g} m "
+                "(1e-12 L), so they are not resolved: scale the load up (the model is linear until contact) or "
+                "read the response from displacement()"
+            )
 
     @property
     def fields(self) -> tuple[str, ...]:
@@ -526,6 +543,17 @@ class SimulationResult:
         from ..plot.response import plot_result
 
         return plot_result(self, path, **kwargs)
+
+
+def _one_dimensional(name: str, values: Any) -> np.ndarray:
+    """``values`` as a 1-D float array; ParameterError naming ``name`` for a 2-D array or a non-number."""
+    try:
+        arr = np.atleast_1d(np.asarray(values, dtype=float))
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected numbers, got {type(values).__name__}") from None
+    if arr.ndim != 1:
+        raise ParameterError(f"{name}: expected a number or a 1-D sequence, got an array of shape {arr.shape}")
+    return arr
 
 
 def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:

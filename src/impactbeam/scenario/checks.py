@@ -24,7 +24,8 @@ squares frequencies (``omega^2``) and products of the beam's section
 properties, so the derived quantities ``A``, ``I``, ``E I``, ``rho A`` and the
 beam's frequency scale ``omega_0 = sqrt(E I / (rho A)) / L^2`` [rad/s] must
 stay within 10^+-150, whose squares (10^+-300) are still normal doubles
-(max ~1.8e308, min normal ~2.2e-308). A contactor's stiffness relative to the
+(max ~1.8e308, min normal ~2.2e-308). The frequency scale itself is
+kept within 10^+-50 (:data:`FREQUENCY_SCALE_LIMIT`). A contactor's stiffness relative to the
 beam, ``kappa = k L^3 / (E I)``, is limited to 10^+-15: above 1e15 the
 spring is rigid to within double round-off (1/kappa < 10 eps), below 1e-15
 it changes nothing at that precision; either way the contact state's modes
@@ -41,15 +42,20 @@ from typing import Any
 from .._warnings import emit_user_level_warning
 from .._memory import check_work
 from ..exceptions import ScenarioError
-from ..model.magnitudes import RESPONSE_LIMIT, frequency_scale, response_estimates, scan_work
+from ..model.magnitudes import RESPONSE_FLOOR, RESPONSE_LIMIT, frequency_scale, response_estimates, scan_work
 from ..units import DIMENSIONS, to_si
 from .schema import path_dimension
 
-__all__ = ["DERIVED_LIMIT", "STIFFNESS_RATIO_LIMIT", "check_magnitudes", "check_response", "check_run",
+__all__ = ["DERIVED_LIMIT", "FREQUENCY_SCALE_LIMIT", "STIFFNESS_RATIO_LIMIT", "check_magnitudes", "check_response", "check_run",
            "warn_numeric_strings"]
 
-#: Derived quantities (A, I, E I, rho A, omega_0) must lie in [1/limit, limit] (SI).
+#: Derived quantities (A, I, E I, rho A) must lie in [1/limit, limit] (SI).
 DERIVED_LIMIT = 1e150
+#: The frequency scale omega_0 [rad/s] must lie in [1/limit, limit]: the closed form squares a
+#: frequency twice (omega^4 in its resonance denominator), so the highest retained frequency (up to
+#: ~1e7 omega_0: 200 modes, the stiffest contactor) must stay below ~1e76, and a load pulse of any
+#: length is integrated at most at 1e70 rad/s (model.loading) far above it.
+FREQUENCY_SCALE_LIMIT = 1e50
 #: k L^3 / (E I) of a contactor must lie in [1/limit, limit] (or k = inf).
 STIFFNESS_RATIO_LIMIT = 1e15
 
@@ -119,20 +125,20 @@ def _check_section(raw: Mapping[str, Any], keys: dict[str, str], L: float) -> No
         a_terms, i_terms = {keys["area"]: a}, {keys["second_moment"]: i}
     if E is None or rho is None:
         return
-    lim = math.log10(DERIVED_LIMIT)
+    lim, f_lim = math.log10(DERIVED_LIMIT), math.log10(FREQUENCY_SCALE_LIMIT)
     checks = (
-        ("an area A", log_a, a_terms),
-        ("a second moment I", log_i, i_terms),
-        ("a bending stiffness E I", E + log_i, {keys["youngs_modulus"]: E, **i_terms}),
-        ("a mass per length rho A", rho + log_a, {keys["density"]: rho, **section}),
+        ("an area A", log_a, a_terms, lim),
+        ("a second moment I", log_i, i_terms, lim),
+        ("a bending stiffness E I", E + log_i, {keys["youngs_modulus"]: E, **i_terms}, lim),
+        ("a mass per length rho A", rho + log_a, {keys["density"]: rho, **section}, lim),
         ("a frequency scale sqrt(E I / rho A) / L^2 [rad/s]", 0.5 * (E + log_i - rho - log_a) - 2 * L,
          {"beam.length": -2 * L, keys["youngs_modulus"]: 0.5 * E, keys["density"]: -0.5 * rho,
-          **{k: 0.5 * v for k, v in section.items()}}),
+          **{k: 0.5 * v for k, v in section.items()}}, f_lim),
     )
-    for what, value, terms in checks:
-        if abs(value) > lim:
+    for what, value, terms, limit in checks:
+        if abs(value) > limit:
             # terms are signed contributions: pick the biggest in the direction of the excess
-            _refuse_contribution(what, value, terms, raw, "check the value and its unit")
+            _refuse_contribution(what, value, terms, raw, "check the value and its unit", limit)
 
 
 def check_magnitudes(raw: Mapping[str, Any]) -> None:
@@ -205,6 +211,14 @@ def check_response(beam: Any, excitation: Any, initial: Any, end_time: float) ->
         Naming the key, the estimate and why.
     """
     for key, metres in response_estimates(beam, excitation, initial, end_time):
+        if 0.0 < metres < RESPONSE_FLOOR and key.startswith("excitation"):
+            raise ScenarioError(
+                f"{key}: would move the beam by ~{metres:.1e} m at most (estimated from the value, the beam's "
+                f"frequency scale {frequency_scale(beam):.3g} rad/s and solver.end_time), below the "
+                f"{RESPONSE_FLOOR:.0e} m under which the closed form underflows to zero; check the value and its "
+                "unit (the load has no effect at double precision)",
+                key=key,
+            )
         if not metres <= RESPONSE_LIMIT:
             raise ScenarioError(
                 f"{key}: would drive the beam to a deflection of ~{metres:.1e} m (estimated from the value, the "
@@ -232,11 +246,11 @@ def check_run(beam: Any, modes: int | str, end_time: float) -> None:
                "fewer modes")
 
 
-def _refuse_contribution(what: str, value: float, terms: dict[str, float], raw: Mapping[str, Any], remedy: str) -> None:
+def _refuse_contribution(what: str, value: float, terms: dict[str, float], raw: Mapping[str, Any], remedy: str,
+                         lim: float) -> None:
     sign = 1.0 if value > 0 else -1.0
     key = max(terms, key=lambda k: sign * terms[k])
     node = _value(raw, key)
-    lim = math.log10(DERIVED_LIMIT)
     raise ScenarioError(
         f"{key}: {node!r} gives {what} of ~1e{value:.0f}, outside what the modal analysis can "
         f"represent (1e-{lim:.0f} to 1e{lim:.0f} in SI); {remedy}",
