@@ -52,12 +52,12 @@ def _size(name: str, default: float) -> float:
     return value
 
 
-#: Default of :func:`work_limit`, in mode-periods (see :func:`impactbeam.model.magnitudes.scan_work`):
-#: about 2 s for the metrics' extrema at the 1 to 2 us per unit measured on one core. The extrema
-#: run as one compiled call, which a Ctrl-C interrupts only when it returns: the limit keeps that
-#: wait below 5 s (Case 3 with 8 modes: end_time up to ~7.8e3 s; undamped with impacts, measured 2.5e6
-#: units gave waits of 4.4 to 6.6 s).
-WORK_LIMIT = 1e6
+#: Default of :func:`work_limit`, in mode-periods (see :func:`impactbeam.model.magnitudes.scan_work`).
+#: The metrics' extrema run as one compiled call, which a Ctrl-C interrupts only when it returns;
+#: measured on one core: 1 to 2 us per unit for damped runs, 4 us for an undamped one with impacts
+#: (Case 3, 9.5e5 units: 3.7 s). The limit keeps that wait near 2 s (Case 3 with 8 modes:
+#: end_time up to ~3.9e3 s); IMPACTBEAM_WORK_LIMIT raises it.
+WORK_LIMIT = 5e5
 
 
 def work_limit() -> float:
@@ -86,7 +86,7 @@ def check_work(units: float, what: str, hint: str) -> None:
         raise ResourceError(
             f"{what} would scan ~{units:.2g} mode-periods (modes x end_time x the beam's frequency scale), "
             f"above the limit of {limit:.2g} (about 2 s of exact extrema, which Ctrl-C cannot interrupt; this "
-            f"would take ~{units * 2e-6:.2g} s); {hint} (or raise IMPACTBEAM_WORK_LIMIT)"
+            f"would take ~{units * 2e-6:.2g} to {units * 4e-6:.2g} s); {hint} (or raise IMPACTBEAM_WORK_LIMIT)"
         )
 
 

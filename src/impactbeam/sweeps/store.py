@@ -186,8 +186,13 @@ class _StoreLock:
                     f'{holder.get("host")}, since {when}); wait for it to finish, or remove "{self.path}" if '
                     "that process is gone"
                 ) from None
-            with os.fdopen(fd, "w") as fh:
-                json.dump(me, fh)
+            try:
+                with os.fdopen(fd, "w") as fh:
+                    json.dump(me, fh)
+            except OSError:  # a full disk: the lock was created empty; do not leave it behind
+                with contextlib.suppress(OSError):
+                    os.unlink(self.path)
+                raise
             return self
         raise ParameterError(f'--out: cannot take the lock "{self.path}"')
 
