@@ -106,11 +106,11 @@ CASES = [
      2, "Timoshenko modes: resolving frequencies up to"),
     # wrong answers with exit 0
     ("contactor-at-pin", ["simulate", "s.toml"], {"s.toml": _set(PINNED, "position_ratio", "1.0")}, 2,
-     "contactors.0.position: 0.1092 m is at the right end (pinned)"),
+     "contactors.0.position: 0.1092 m is at the right end (pinned), where w = 0"),
     ("contactor-1e-9-from-pin", ["simulate", "s.toml"], {"s.toml": _set(PINNED, "position_ratio", "0.999999999")}, 2,
      "the contactor can never act"),
     ("contactor-at-clamp", ["modes", "s.toml"], {"s.toml": _set(CASE3, "position_ratio", "0.0")}, 2,
-     "contactors.0.position: 0 m is at the left end (clamped)"),
+     "contactors.0.position: 0 m is at the left end (clamped), where w = 0"),
     ("contactor-1e-3-from-pin", ["simulate", "s.toml", "--json"], {"s.toml": _set(PINNED, "position_ratio", "0.999")},
      0, '"max_response"'),
     ("stress-area-and-I", ["simulate", "s.toml"],

@@ -118,7 +118,7 @@ REFUSED = [
     # issue 20: a contactor where the support holds w = 0 can never act (it was a warning, and the
     # enriched basis then gave a growing deflection at the support): refused
     pytest.param(BEAM + SHORT + PULSE + '[[contactors]]\nposition = 0\nstiffness = 4030\ngap = 1e-4\n',
-                 "contactors.0.position: 0 m is at the left end (clamped)", id="contactor-at-clamped-end"),
+                 "contactors.0.position: 0 m is at the left end (clamped), where w = 0", id="contactor-at-clamped-end"),
 ]
 
 

@@ -509,7 +509,7 @@ class Contactor:
         held = beam.fixed_at(self.position)
         if held is not None:
             raise ParameterError(
-                f"{name}.position: {self.position:g} m is at {held} (w = 0 there, within "
-                f"{MERGE_DISTANCE:g} L), so the contactor can never act; remove it, or place it at least "
+                f"{name}.position: {self.position:g} m is at {held}, where w = 0 (within {MERGE_DISTANCE:g} L), "
+                "so the contactor can never act; remove it, or place it at least "
                 f"{MERGE_DISTANCE * beam.length:.3g} m from the support"
             )
