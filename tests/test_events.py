@@ -22,7 +22,8 @@ import pytest
 
 import impactbeam as ib
 from impactbeam.model.beam import Beam, Contactor
-from impactbeam.model.loading import Excitation, InitialCondition
+from impactbeam.model.loading import Excitation
+from impactbeam.model.starting import InitialCondition
 from impactbeam.model import Damping, SolverOptions
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -41,9 +41,12 @@ def _long_scenario(tmp: Path) -> Path:
 def test_simulate_stops_on_signal(tmp_path, sig, code):
     sc = _long_scenario(tmp_path)
     out = tmp_path / "res.nc"
+    # 1e5 s is above the default work limit (its exact extrema would hold a signal for minutes); this
+    # test is about the compiled loop, which returns to Python at checkpoints, so the limit is raised
     proc = subprocess.Popen(
         [*CLI, "simulate", str(sc), "--end-time", "1e5", "--time-step", "1", "--out", str(out), "--json"],
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        env={**os.environ, "IMPACTBEAM_WORK_LIMIT": "1e9"},
     )
     time.sleep(8.0)  # start-up (imports, cached kernels) and well into the run
     assert proc.poll() is None, proc.communicate()

@@ -1,10 +1,11 @@
-"""Output sizes and the memory limit: sampled histories are estimated before they are allocated.
+"""Output sizes, the memory limit and the work limit: requests are estimated before they are run.
 
 A result's histories (``w`` at the output points and contactors, contact
 forces, modal coordinates, energies) are evaluated lazily; before any of them
 is allocated, :func:`check_output_size` compares the estimate with
 :func:`memory_limit` and refuses a request that would not fit, with the
-estimate and a way to ask for less.
+estimate and a way to ask for less. A run whose work is out of proportion
+(:func:`check_work`, against :func:`work_limit`) is refused the same way.
 """
 
 from __future__ import annotations
@@ -14,7 +15,12 @@ import os
 
 from .exceptions import ParameterError, ResourceError
 
-__all__ = ["sample_count", "memory_limit", "check_memory", "output_bytes", "check_output_size"]
+__all__ = ["MAX_OUTPUT_SAMPLES", "sample_count", "memory_limit", "check_memory", "output_bytes", "check_output_size",
+           "work_limit", "check_work"]
+
+#: Most output samples of one history (``solver.time_step``, a sweep's ``outputs.histories``): 5e7
+#: samples of one point already take 400 MB.
+MAX_OUTPUT_SAMPLES = 50_000_000
 
 
 def sample_count(end_time: float, time_step: float) -> int:
@@ -31,6 +37,59 @@ def sample_count(end_time: float, time_step: float) -> int:
     return int(math.floor(end_time / time_step * (1.0 + 1e-12))) + 1
 
 
+def _size(name: str, default: float) -> float:
+    """The number in environment variable ``name`` (a ``K``, ``M`` or ``G`` suffix allowed), else ``default``."""
+    raw = os.environ.get(name, "").strip().upper()
+    if not raw:
+        return default
+    mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
+    try:
+        value = float(raw.rstrip("KMGB") or "nan") * mult
+    except ValueError:
+        value = math.nan
+    if not value > 0:
+        raise ParameterError(f"{name}: not a positive size: {raw!r}")
+    return value
+
+
+#: Default of :func:`work_limit`, in mode-periods (see :func:`impactbeam.model.magnitudes.scan_work`).
+#: The metrics' extrema run as one compiled call, which a Ctrl-C interrupts only when it returns;
+#: measured on one core: 1 to 2 us per unit for damped runs, 4 us for an undamped one with impacts
+#: (Case 3, 9.5e5 units: 3.7 s). The limit keeps that wait near 2 s (Case 3 with 8 modes:
+#: end_time up to ~3.9e3 s); IMPACTBEAM_WORK_LIMIT raises it.
+WORK_LIMIT = 5e5
+
+
+def work_limit() -> float:
+    """Mode-periods a run may scan: ``IMPACTBEAM_WORK_LIMIT`` (a number), default :data:`WORK_LIMIT`."""
+    return _size("IMPACTBEAM_WORK_LIMIT", WORK_LIMIT)
+
+
+def check_work(units: float, what: str, hint: str) -> None:
+    """Raise ResourceError before a run whose work exceeds :func:`work_limit`.
+
+    Parameters
+    ----------
+    units : float
+        The run's work in mode-periods.
+    what : str
+        The request, for the message.
+    hint : str
+        How to ask for less, for the message.
+
+    Raises
+    ------
+    ResourceError
+    """
+    limit = work_limit()
+    if units > limit:
+        raise ResourceError(
+            f"{what} would scan ~{units:.2g} mode-periods (modes x end_time x the beam's frequency scale), "
+            f"above the limit of {limit:.2g} (about 2 s of exact extrema, which Ctrl-C cannot interrupt; this "
+            f"would take ~{units * 2e-6:.2g} to {units * 4e-6:.2g} s); {hint} (or raise IMPACTBEAM_WORK_LIMIT)"
+        )
+
+
 def memory_limit() -> int:
     """Bytes a request may allocate for sampled histories.
 
@@ -39,14 +98,7 @@ def memory_limit() -> int:
     physical memory, and 80 % of the process's address-space limit
     (``ulimit -v``) when one is set.
     """
-    raw = os.environ.get("IMPACTBEAM_MEMORY_LIMIT", "").strip().upper()
-    limit = 4 << 30
-    if raw:
-        mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
-        try:
-            limit = int(float(raw.rstrip("KMGB") or "nan") * mult)
-        except ValueError:
-            raise ParameterError(f"IMPACTBEAM_MEMORY_LIMIT: not a size: {raw!r}") from None
+    limit = int(_size("IMPACTBEAM_MEMORY_LIMIT", 4 << 30))
     try:
         limit = min(limit, os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2)
     except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX

@@ -22,7 +22,8 @@ from ._warnings import emit_user_level_warning as warn
 from .exceptions import ParameterError
 from .model import MAX_MODES, Damping, SolverOptions
 from .model.beam import Beam, Contactor
-from .model.loading import Excitation, InitialCondition, Preload
+from .model.loading import Excitation
+from .model.starting import InitialCondition, Preload
 from .result import SimulationResult
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
 from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, estimate

@@ -7,7 +7,10 @@ unit that :mod:`pint` understands (``"0.229 mm"``, ``"15 ms"``, ``"1834 MPa"``,
 * for accelerations, ``g`` means standard gravity, 9.80665 m/s^2
   (``"15 g"``, ``"0.5 g"``), also in acceleration spectral densities
   (``"0.01 g^2/Hz"``); pint's own ``g`` is the gram;
-* ``"inf"`` (or ``"infinity"``) is accepted for stiffnesses only, meaning rigid.
+* ``"inf"`` (or ``"infinity"``) is accepted for stiffnesses only, meaning rigid;
+* a frequency is cyclic (Hz): an angular frequency is converted as such,
+  ``"60 rad/s"`` is 9.549 Hz and ``"60 rpm"`` 1 Hz (pint alone takes the
+  radian as dimensionless and would read them as 60 Hz and 6.283 Hz).
 
 NaN is rejected everywhere. Every error is a :class:`~impactbeam.exceptions.ScenarioError`
 whose message starts with the dotted key of the field, names the value received
@@ -114,7 +117,7 @@ _KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
 _UREG: Any = None
 _NUMBER_START = re.compile(r"^\s*[-+]?(\d|\.\d)")
 _NUMBER_UNIT = re.compile(
-    r"^\s*(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?i:inf(?:inity)?|nan))"
+    r"^\s*(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?i:inf(?:inity)?|nan))(?![\d.])"
     r"\s*(?P<unit>[^\s*/^].*?)\s*$"
 )
 _GRAVITY_G = re.compile(r"(?<![\w.])g(?![\w.])")
@@ -200,7 +203,30 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
         raise _UnitProblem(
             f'"{text}" is {_name_of(quantity.dimensionality)}, expected {describe_dimension(dimension)}'
         )
+    if dimension == "frequency":
+        return _cyclic_frequency(quantity, text)
     return float(quantity.to(target).magnitude)
+
+
+def _cyclic_frequency(quantity: Any, text: str) -> float:
+    """A frequency in Hz (cycles per second) from a cyclic or an angular quantity.
+
+    pint takes the radian as dimensionless, so it would read ``"60 rad/s"``
+    as 60 Hz and ``"60 rpm"`` (a revolution is 2 pi rad) as 2 pi Hz. Here the
+    angle in the unit is kept: a unit without an angle (``Hz``, ``1/s``,
+    ``1/min``) counts cycles; one with an angle per time (``rad/s``,
+    ``deg/s``, ``rpm``, ``turn/s``, ``cycle/s``) is an angular frequency,
+    divided by 2 pi rad per cycle. ``"60 rad/s"`` is 9.549 Hz, ``"60 rpm"``
+    and ``"1 cycle/s"`` are 1 Hz.
+    """
+    root = quantity.to_root_units()
+    powers = dict(root.units._units)
+    angle = powers.pop("radian", 0)
+    if powers != {"second": -1} or angle not in (0, 1):
+        raise _UnitProblem(f'"{text}" is not a frequency (cycles or an angle per time), expected '
+                           f"{describe_dimension('frequency')}")
+    magnitude = float(root.magnitude)
+    return magnitude / (2.0 * math.pi) if angle == 1 else magnitude
 
 
 def _parse(text: str, dimension: str, shown: str | None = None) -> Any:

@@ -4,7 +4,10 @@ Every command reports bad input (:class:`~impactbeam.exceptions.ParameterError`,
 which includes :class:`~impactbeam.exceptions.ScenarioError`) as exactly one
 line ``error: <message>`` on stderr and exits with status 2; a failed
 computation (:class:`~impactbeam.exceptions.SimulationError` and other
-:class:`~impactbeam.exceptions.ImpactBeamError`) exits with status 1. Never a
+:class:`~impactbeam.exceptions.ImpactBeamError`) exits with status 1, and so
+does a file that cannot be written (:class:`~impactbeam._io.WriteError`, its
+line prefixed by the option the path came from, ``--out: cannot write ...``),
+any other operating-system error and running out of memory. Never a
 traceback for those.
 
 Ctrl-C ends a command with status 130 and SIGTERM with 143, with one line
@@ -18,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import functools
+import os
 import signal
 import sys
 import threading
@@ -78,8 +82,13 @@ def handle_errors(fn: F) -> F:
                 out = fn(*args, **kwargs)
             except ParameterError as exc:
                 fail(str(exc), 2)
-            except ImpactBeamError as exc:  # SimulationError, ModeSolveError, ...
-                fail(str(exc), 1)
+            except ImpactBeamError as exc:  # SimulationError, ModeSolveError, WriteError ...
+                fail(_named(exc), 1)
+            except OSError as exc:  # a file or a port the command did not report itself
+                fail(_os_error(exc), 1)
+            except MemoryError:
+                fail("out of memory: the request is larger than this machine can hold; ask for less "
+                     "(a larger solver.time_step, fewer points, modes or cases)", 1)
             finally:
                 _WARNING_LOG.reset(token)
         if not log.consumed:
@@ -88,6 +97,42 @@ def handle_errors(fn: F) -> F:
         return out
 
     return wrapper  # type: ignore[return-value]
+
+
+def _option_of(path: str) -> str | None:
+    """The option (``--out``) or argument of the running command whose value is ``path``."""
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return None
+    target = os.path.normpath(path)
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name or "")
+        if isinstance(value, str) and value and os.path.normpath(value) == target:
+            if isinstance(param, click.Option):
+                return max(param.opts, key=len)
+            return param.human_readable_name
+    return None
+
+
+def _named(exc: ImpactBeamError) -> str:
+    """The message, with the option a failed write came from (``--out: cannot write ...``)."""
+    from .._io import WriteError
+
+    if isinstance(exc, WriteError) and exc.option is None:
+        option = _option_of(exc.path)
+        if option is not None:
+            return f"{option}: {exc}"
+    return str(exc)
+
+
+def _os_error(exc: OSError) -> str:
+    """One line for an operating-system error: the option or file, and the system's reason."""
+    reason = exc.strerror or " ".join(str(exc).split()) or type(exc).__name__
+    name = exc.filename
+    if name is None:
+        return reason
+    option = _option_of(os.fspath(name))
+    return f'{option + ": " if option else ""}"{os.fspath(name)}": {reason}'
 
 
 def number_or_text(value: Any) -> Any:

@@ -4,9 +4,24 @@ from __future__ import annotations
 
 import click
 
+from ..exceptions import ParameterError
 from ._group import handle_errors
 
 __all__ = ["explore"]
+
+
+def _check_port(port: int) -> None:
+    """ParameterError naming --port when 127.0.0.1:port cannot be listened on (in use, not allowed)."""
+    import socket
+
+    if port == 0:  # any free port
+        return
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        try:
+            sock.bind(("127.0.0.1", port))
+        except OSError as exc:
+            raise ParameterError(f"--port: cannot serve on 127.0.0.1:{port}: {exc.strerror or exc} "
+                                 "(another server uses it?); choose another port") from None
 
 
 @click.command("explore")
@@ -25,6 +40,7 @@ def explore(scenario: str | None, port: int, show: bool) -> None:
     """
     from .._optional import require
 
+    _check_port(port)
     require("panel", "explore", feature="impactbeam explore")
     from ..explore import serve
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from .._io import PLOT_SUFFIXES, check_output, json_text
+from .._io import PLOT_SUFFIXES, WriteError, check_output, json_text
 from ._group import handle_errors, number_or_text, take_warnings
 from ..exceptions import ParameterError
 
@@ -158,22 +158,33 @@ def identify(
             click.echo(f"note: no logarithmic decrement at {d.frequency_hz:.4g} Hz: {d.log_decrement_note}", err=True)
     result = ident.to_dict()
     result["record"] = record
+    data = None
     if sc is not None:
         result["scenario"] = scenario
         if contact_record is not None:
             result["contact_record"] = contact_record
         if out is not None:
-            from ..scenario import dump_scenario, set_path
+            from ..scenario import set_path
 
             data = sc.data
             for path, value in ident.updates.items():
                 data = set_path(data, path, value)
-            dump_scenario(data, out)
             result["out"] = out
+    failure: WriteError | None = None
+    if out is not None and data is not None:
+        from ..scenario import dump_scenario
+
+        try:
+            dump_scenario(data, out)
+        except WriteError as exc:  # reported after the identified values, so they are not lost
+            failure = exc
+            result["out"] = None
     if as_json:
         click.echo(json_text({**result, "warnings": take_warnings()}))
     else:  # the warnings go to stderr, printed by handle_errors when the command ends
         click.echo(_identify_text(result))
+    if failure is not None:
+        raise failure
     if out is not None:
         click.echo(f"wrote scenario to {out}", err=True)
 
@@ -331,8 +342,12 @@ def fit(
     res = run_fit(sc, meas, paths, bounds=bnds, point=x, excitation=trace, hold=hold,  # type: ignore[arg-type]
                   window=win, max_nfev=max_nfev, conf_interval=conf_interval)
     written: list[Path] = []
+    failure: WriteError | None = None
     if out is not None:
-        written = res.write_scenario(out)
+        try:
+            written = res.write_scenario(out)
+        except WriteError as exc:  # reported after the fitted values, so they are not lost
+            failure = exc
     if as_json:
         d = res.to_dict()
         d.update({"scenario": scenario, "measured": measured, "out": out,
@@ -342,3 +357,5 @@ def fit(
         click.echo(res.report())
     for p in written:
         click.echo(f"wrote {p}", err=True)
+    if failure is not None:
+        raise failure

@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from .._io import json_text
+from .._io import PLOT_SUFFIXES, check_output, json_text
 from ..exceptions import ParameterError
 from ._group import handle_errors, load_with_overrides
 
@@ -37,6 +37,7 @@ def modes(scenario: str, count: int | None, as_json: bool, plot_path: str | None
         raise ParameterError(f"--count: expected 1 to {MAX_MODES} modes (the limit of solver.modes), got {count}")
     if count is not None and count < 1:
         raise ParameterError(f"--count: must be a positive integer, got {count}")
+    check_output("--plot", plot_path, PLOT_SUFFIXES)
     sc = load_with_overrides(scenario)
     from ..modal import scenario_modes
 

@@ -103,15 +103,11 @@ def simulate(
     if out is not None:
         try:
             write_result(result, out)
-        except OSError as exc:
-            fail(f'--out: cannot write "{out}": {exc.strerror or exc}', 1)
         except ImportError as exc:  # an optional writer backend is missing
             fail(f'--out: cannot write "{out}": {exc}', 1)
     if plot is not None:
         try:
             plot_result(result, plot, excitation=sc.excitation)
-        except OSError as exc:
-            fail(f'--plot: cannot write "{plot}": {exc.strerror or exc}', 1)
         except ImportError as exc:
             fail(f'--plot: cannot write "{plot}": {exc}', 1)
     if as_json:

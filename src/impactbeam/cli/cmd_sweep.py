@@ -57,8 +57,9 @@ def sweep_command(
     """
     if workers is not None and scheduler is not None:
         raise ParameterError("--workers and --scheduler exclude each other (a local cluster or a running one)")
-    if workers is not None and workers < 0:
-        raise ParameterError(f"--workers: must be >= 0, got {workers}")
+    from ..sweeps.cluster import check_workers
+
+    check_workers(workers)
     if batch_size is not None and batch_size < 1:
         raise ParameterError(f"--batch-size: must be a positive integer, got {batch_size}")
     from ..sweeps import SweepInterrupted, load_sweep, run_sweep

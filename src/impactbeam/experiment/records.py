@@ -271,6 +271,9 @@ def load_record(
         raise ScenarioError(f"{label}: file not found", key="record")
     if p.is_dir():
         raise ScenarioError(f"{label}: is a directory, not a record file", key="record")
+    if not p.is_file():  # a device or a pipe: never read (the text reader says the same for CSV)
+        raise ScenarioError(f"{label}: is not a regular file (a device, a pipe or a socket); give a record file",
+                            key="record")
     if p.suffix.lower() in _NETCDF_SUFFIXES:
         t, v, name, q, rows = _read_netcdf(p, label, time_unit, value_unit, channel, quantity)
     else:

@@ -43,10 +43,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .roots import brentq
-from ..model.beam import Beam
+from ..model.beam import MERGE_DISTANCE, Beam
 from ..exceptions import ModeSolveError, ParameterError
 
-_MERGE_DISTANCE = 3e-5  # fraction of L
 _GAUSS_ORDER = 20
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(_GAUSS_ORDER)
 
@@ -100,7 +99,7 @@ def layout(beam: Beam, springs: Iterable[tuple[float, float]] = ()) -> Layout:
     makes the exact dynamic stiffness too ill-conditioned to count roots.
     """
     L = beam.length
-    tol = _MERGE_DISTANCE * L
+    tol = MERGE_DISTANCE * L
     nodes: dict[float, list[float]] = {
         0.0: [beam.left.translational, beam.left.rotational, 0.0, 0.0],
         L: [beam.right.translational, beam.right.rotational, 0.0, 0.0],
@@ -352,8 +351,46 @@ def count(lay: Layout, beta: float) -> int:
             else:
                 K[dof, dof] += kap
     Kr = K[np.ix_(keep, keep)]
-    neg = int(np.sum(np.linalg.eigvalsh(Kr) < 0.0)) if Kr.size else 0
-    return _clamped_count(beta * r * lens) + neg
+    return _clamped_count(beta * r * lens) + negative_eigenvalues(Kr)
+
+
+def negative_eigenvalues(K: np.ndarray) -> int:
+    """Number of negative eigenvalues of a symmetric matrix, from its inertia (Sylvester's law).
+
+    A symmetric indefinite factorisation ``K = L D L^T`` with Bunch-Kaufman
+    pivoting (:func:`scipy.linalg.ldl`) has the inertia of ``K`` in its 1x1
+    and 2x2 blocks ``D``. Unlike the eigenvalues, whose absolute error is
+    ``eps`` times the largest entry, the pivots keep their relative
+    accuracy when the entries span many decades: a support spring of 1e15
+    beside the beam's stiffness, or a short stiff segment, is eliminated
+    first and leaves the rest exact (with the eigenvalues, the count and
+    with it the modes went wrong there).
+
+    Parameters
+    ----------
+    K : ndarray, (n, n)
+        Symmetric.
+
+    Returns
+    -------
+    int
+    """
+    if K.size == 0:
+        return 0
+    from scipy.linalg import ldl
+
+    _, D, _ = ldl(K, lower=True, hermitian=True)
+    neg, i, n = 0, 0, D.shape[0]
+    while i < n:
+        if i + 1 < n and D[i + 1, i] != 0.0:  # a 2x2 block: one negative eigenvalue if its determinant is < 0
+            a, b, c = D[i, i], D[i + 1, i], D[i + 1, i + 1]
+            det = a * c - b * b
+            neg += 1 if det < 0.0 else (2 if a + c < 0.0 else 0)
+            i += 2
+        else:
+            neg += int(D[i, i] < 0.0)
+            i += 1
+    return neg
 
 
 # --------------------------------------------------------------------------- rigid-body modes
@@ -384,9 +421,11 @@ def rigid_modes(lay: Layout, rotary: float = 0.0) -> np.ndarray:
         rows.append([0.0, 1.0])
     L = lay.nodes[-1]
     if rows:
-        C = np.array(rows)
-        scale = np.array([1.0, L])
-        _, sv, vt = np.linalg.svd(C * scale)
+        # in the dimensionless unknowns (c0, c1 L), each constraint scaled to unit length: the rank
+        # must not depend on the units (with (c0, c1 / L) a beam of 1e-10 m lost its clamp's rotation)
+        scale = np.array([1.0, 1.0 / L])
+        C = np.array(rows) * scale
+        _, sv, vt = np.linalg.svd(C / np.linalg.norm(C, axis=1, keepdims=True))
         rank = int(np.sum(sv > 1e-10 * sv[0]))
         null = (vt[rank:] * scale).T  # (2, r)
     else:

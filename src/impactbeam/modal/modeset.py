@@ -504,9 +504,23 @@ def scenario_modes(scenario: Scenario, count: int | None = None) -> ScenarioMode
     ----------
     scenario : Scenario
     count : int, optional
-        Modes per state; default the scenario's ``solver.modes``.
+        Modes per state; default the scenario's ``solver.modes`` (required when that is ``"auto"``).
+
+    Raises
+    ------
+    TypeError
+        When ``scenario`` is not a Scenario.
+    ParameterError
+        For ``solver.modes = "auto"`` without ``count``, or a bad ``count``.
     """
+    from ..scenario import Scenario
+
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"modes: expected a Scenario (from impactbeam.load_scenario), got {type(scenario).__name__}")
     n = scenario.solver.modes if count is None else count
+    if n == "auto":
+        raise ParameterError('count: the scenario has solver.modes = "auto", which a simulation settles; give the '
+                             "number of modes (modes(scenario, count=8), impactbeam modes --count 8)")
     free = mode_set(scenario.beam, (), n)
     contact = None
     if scenario.contactors:

@@ -30,7 +30,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .euler import layout
+from .euler import layout, rigid_modes
 from ..exceptions import ParameterError
 from ..model.beam import Beam
 
@@ -94,11 +94,14 @@ def _solve(beam: Beam, forces: tuple[tuple[float, float], ...], per_length: tupl
             else:
                 K[dof, dof] += spring
     d = np.zeros(2 * n)
+    if rigid_modes(lay).size:  # from the supports themselves, not from the conditioning of K
+        raise ParameterError("static response: the supports let the beam move as a rigid body (no static solution)")
     Kf = K[np.ix_(free, free)]
     if Kf.size:
-        if np.linalg.cond(Kf) > 1e13:
-            raise ParameterError("static response: the supports let the beam move as a rigid body")
-        d[free] = np.linalg.solve(Kf, f[free])
+        # symmetric diagonal scaling: a stiff spring (1e15) or a short piece beside the rest is no
+        # longer an ill-conditioning, and the solve keeps the accuracy of the scaled system
+        scale = 1.0 / np.sqrt(np.abs(np.diag(Kf)))
+        d[free] = scale * np.linalg.solve(Kf * scale[:, None] * scale[None, :], f[free] * scale)
     rows = [(*d[2 * j: 2 * j + 2], *(G @ np.append(d[2 * j: 2 * j + 4], 1.0)), q, EI, flex)
             for j, (G, q, EI, flex) in enumerate(mats)]
     return nodes, np.array(rows)

@@ -58,10 +58,10 @@ import numpy as np
 
 from .euler import Layout, bracket_wavenumbers
 from .roots import brentq
-from ..exceptions import ModeSolveError
+from ..exceptions import ModeSolveError, ResourceError
 from ..model.beam import Beam
 
-__all__ = ["Segments", "TimoshenkoShapes", "segments", "solve"]
+__all__ = ["Segments", "TimoshenkoShapes", "negative_pivots", "segments", "solve"]
 
 _TERMS = 26  # Taylor terms of exp(A h) with spectral radius <= 1: truncation < 1 / 27!
 _FACT = np.array([math.factorial(n) for n in range(_TERMS + 1)], dtype=float)
@@ -233,9 +233,7 @@ class Mesh:
 
     def count(self, omega: float) -> int:
         """Natural frequencies below ``omega`` (valid for omega up to the mesh's frequency)."""
-        from scipy.linalg import eigvals_banded
-
-        return int(eigvals_banded(self.band(omega), lower=True, select="v", select_range=(-np.inf, 0.0)).size)
+        return negative_pivots(self.band(omega))
 
     def eigen(self, omega: float, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
         """Eigenvalues ``lo..hi`` (ascending, inclusive) of the dynamic stiffness and their vectors."""
@@ -244,9 +242,70 @@ class Mesh:
         return eig_banded(self.band(omega), lower=True, select="i", select_range=(lo, hi))
 
 
+def negative_pivots(ab: np.ndarray) -> int:
+    """Negative eigenvalues of the banded dynamic stiffness: its inertia by a block ``L D L^T`` over the nodes.
+
+    The matrix (lower band storage ``ab``, 2 degrees of freedom per node,
+    elements joining neighbouring nodes) is block tridiagonal with 2x2
+    blocks ``A_g`` on the diagonal and ``B_g`` below it. The Schur
+    complements ``S_g = A_g - B_{g-1} S_{g-1}^{-1} B_{g-1}^T`` have together
+    the inertia of the matrix (Haynsworth), so the count is the number of
+    negative eigenvalues of the ``S_g``: the Wittrick-Williams sign count in
+    ``O(nodes)`` operations (Gaussian elimination without interchanges, as
+    Wittrick and Williams count), against ``O(nodes^2)`` for the eigenvalues.
+    A singular ``S_g`` (``omega`` exactly at a frequency of the part of the
+    beam up to that node) is moved off zero by one unit of round-off.
+
+    Parameters
+    ----------
+    ab : ndarray, (4, 2 n_nodes)
+        Lower band storage: ``ab[r, c] = K[c + r, c]``.
+
+    Returns
+    -------
+    int
+    """
+    d0, d1, d2, d3 = (row.tolist() for row in ab)
+    tiny = np.finfo(float).eps
+    neg = 0
+    s11 = s12 = s22 = det = 0.0
+    for i in range(0, len(d0) - 1, 2):
+        a11, a12, a22 = d0[i], d1[i], d0[i + 1]
+        if i:
+            b11, b12, b21, b22 = d2[i - 2], d1[i - 1], d3[i - 2], d2[i - 1]  # K[node g, node g-1]
+            # B adj(S) B^T / det(S), adj(S) = [[s22, -s12], [-s12, s11]]
+            u11, u12 = b11 * s22 - b12 * s12, b12 * s11 - b11 * s12
+            u21, u22 = b21 * s22 - b22 * s12, b22 * s11 - b21 * s12
+            a11 -= (u11 * b11 + u12 * b12) / det
+            a12 -= (u11 * b21 + u12 * b22) / det
+            a22 -= (u21 * b21 + u22 * b22) / det
+        det = a11 * a22 - a12 * a12
+        if det == 0.0:
+            det = tiny * (abs(a11) + abs(a22)) ** 2 or tiny
+        neg += 1 if det < 0.0 else (2 if a11 + a22 < 0.0 else 0)
+        s11, s12, s22 = a11, a12, a22
+    return neg
+
+
+#: Most elements of a mesh. 200 modes of a beam of L/h = 5 need 3875 at most; a mesh far finer means
+#: a shear stiffness ``kappa G A`` negligible against ``E I / L^2`` (shear modes without end below
+#: any frequency), and its shapes would take 4.5 kB per element and mode.
+MAX_ELEMENTS = 200_000
+_BYTES_PER_ELEMENT = 4608  # the series of a null vector (27 x 4 x 4 doubles) and its coefficients
+
+
 def _mesh(seg: Segments, omega: float) -> Mesh:
     n = subdivision(seg, omega)
-    return Mesh(seg, n, float(seg.lay.nodes[-1] / n.sum()))
+    total = int(n.sum())
+    if total > MAX_ELEMENTS:
+        raise ResourceError(
+            f"Timoshenko modes: resolving frequencies up to {omega / (2 * math.pi):.3g} Hz needs {total:.3g} "
+            f"elements (~{total * _BYTES_PER_ELEMENT / 2**30:.3g} GiB for the mode shapes), more than "
+            f"{MAX_ELEMENTS}: the shear stiffness kappa G A = {float(np.min(seg.GA)):.3g} N is negligible "
+            f"against the bending stiffness E I / L^2; check beam.shear_coefficient and beam.poisson_ratio "
+            "(or shear_modulus), or use fewer modes"
+        )
+    return Mesh(seg, n, float(seg.lay.nodes[-1] / total))
 
 
 def count_below(seg: Segments, omega: float) -> int:

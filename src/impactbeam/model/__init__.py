@@ -15,7 +15,8 @@ from __future__ import annotations
 
 from .beam import SUPPORT_PRESETS, Beam, Contactor, InteriorSpring, PointMass, Section, Support
 from .damping import Damping
-from .loading import Excitation, InitialCondition, Preload, Profile
+from .loading import Excitation
+from .starting import InitialCondition, Preload, Profile
 from .options import BASES, MAX_MODES, SolverOptions
 
 __all__ = [

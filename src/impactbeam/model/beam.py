@@ -24,7 +24,13 @@ import numpy as np
 from .._validation import choice, nonnegative_finite, positive_finite, stiffness
 from ..exceptions import ParameterError
 
-__all__ = ["Support", "Beam", "Contactor", "Section", "PointMass", "InteriorSpring", "SUPPORT_PRESETS", "Side"]
+__all__ = ["Support", "Beam", "Contactor", "Section", "PointMass", "InteriorSpring", "SUPPORT_PRESETS", "Side",
+           "MERGE_DISTANCE"]
+
+#: Attachments (springs, masses, contact springs) closer than this fraction of the length to a node
+#: (an end, a section step, an earlier attachment) sit at that node in the modal analysis: a
+#: shorter segment makes the exact dynamic stiffness too ill-conditioned to count roots.
+MERGE_DISTANCE = 3e-5
 
 Side = Literal["below", "above"]
 
@@ -229,6 +235,16 @@ class Beam:
                 raise ParameterError(
                     f"beam.sections: the section lengths sum to {total:.12g} m, not beam.length = {self.length:.12g} m"
                 )
+        for i, sec in enumerate(self.sections):
+            # measured: a section of 1e-5 L is exact, one of 1e-7 L gives no modes at all (its exact
+            # dynamic stiffness overflows); below MERGE_DISTANCE attachments are merged for the same reason
+            if sec.length < MERGE_DISTANCE * self.length:
+                raise ParameterError(
+                    f"beam.sections[{i}].length: {sec.length:g} m is {sec.length / self.length:.2g} of the beam; a "
+                    f"section shorter than {MERGE_DISTANCE:g} L ({MERGE_DISTANCE * self.length:.3g} m) cannot be "
+                    "resolved by the modal analysis in double precision: merge it into a neighbour (a short "
+                    "flexible joint is a rotational spring, [[springs]])"
+                )
         self._check_theory()
         tol = 1e-12 * self.length
         for name in ("masses", "springs"):
@@ -386,6 +402,32 @@ class Beam:
         """
         return 0.5 * self._piece_values(x, "height")
 
+    def fixed_at(self, x: float) -> str | None:
+        """What holds the deflection at ``x`` at zero, or None.
+
+        An end or a permanent spring with a rigid translational stiffness,
+        within :data:`MERGE_DISTANCE` of the length of ``x`` (closer, the
+        modal analysis puts an attachment at that support).
+
+        Parameters
+        ----------
+        x : float, [m]
+            A position on the beam.
+
+        Returns
+        -------
+        str or None
+            E.g. ``"the right end (pinned)"``.
+        """
+        tol = MERGE_DISTANCE * self.length
+        for end, at, support in (("left", 0.0, self.left), ("right", self.length, self.right)):
+            if abs(x - at) <= tol and math.isinf(support.translational):
+                return f"the {end} end ({support.describe()})"
+        for i, sp in enumerate(self.springs):
+            if abs(x - sp.position) <= tol and math.isinf(sp.translational):
+                return f"springs.{i} (a rigid support at {sp.position:g} m)"
+        return None
+
     @property
     def total_mass(self) -> float:
         """Mass of the beam and its point masses [kg]."""
@@ -496,7 +538,10 @@ class Contactor:
         return np.maximum(f, 0.0)
 
     def check_on(self, beam: Beam, name: str = "contactor") -> None:
-        """Raise ParameterError unless the contactor lies on ``beam``.
+        """Raise ParameterError unless the contactor lies on ``beam``, away from a rigid support.
+
+        At a support that holds ``w = 0`` (:meth:`Beam.fixed_at`) a contactor
+        can never act; it is refused rather than simulated.
 
         Parameters
         ----------
@@ -507,4 +552,11 @@ class Contactor:
         if self.position > beam.length * (1.0 + 1e-12):
             raise ParameterError(
                 f"{name}.position: {self.position:g} m is off the beam (length {beam.length:g} m)"
+            )
+        held = beam.fixed_at(self.position)
+        if held is not None:
+            raise ParameterError(
+                f"{name}.position: {self.position:g} m is at {held}, where w = 0 (within {MERGE_DISTANCE:g} L), "
+                "so the contactor can never act; remove it, or place it at least "
+                f"{MERGE_DISTANCE * beam.length:.3g} m from the support"
             )

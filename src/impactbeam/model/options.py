@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._memory import MAX_OUTPUT_SAMPLES
 from .._validation import positive_finite
 from ..exceptions import ParameterError
 
@@ -94,9 +95,10 @@ class SolverOptions:
             raise ParameterError(
                 f"solver.time_step: {self.time_step:g} s is longer than solver.end_time {self.end_time:g} s"
             )
-        if self.end_time / self.time_step > 5e7:
+        if self.end_time / self.time_step > MAX_OUTPUT_SAMPLES:
             raise ParameterError(
-                f"solver.time_step: {self.end_time / self.time_step:.3g} output samples is too many (max 5e7)"
+                f"solver.time_step: {self.end_time / self.time_step:.3g} output samples is too many "
+                f"(max {MAX_OUTPUT_SAMPLES:.0e})"
             )
         if isinstance(self.max_events, bool) or not isinstance(self.max_events, (int, np.integer)) or self.max_events < 1:
             raise ParameterError(f"solver.max_events: must be a positive integer, got {self.max_events!r}")

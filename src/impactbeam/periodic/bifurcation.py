@@ -127,12 +127,15 @@ class BifurcationDiagram:
         ----------
         path : str or path-like
             The ``.nc`` file.
-        """
-        from .._io import atomic_path
 
-        ds = self.to_xarray()
-        with atomic_path(path) as tmp:
-            ds.to_netcdf(tmp, engine="h5netcdf")
+        Raises
+        ------
+        WriteError
+            The file could not be written (a read-only or full file system): nothing is left behind.
+        """
+        from .._io import write_netcdf
+
+        write_netcdf(self.to_xarray(), path)
 
     def plot(self, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
         """The diagram (see :func:`~impactbeam.plot.periodic.plot_bifurcation`); written to ``path`` when given.

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..exceptions import ParameterError
 from .bifurcation import BifurcationDiagram, bifurcation
 from .strobe import PERIOD_TOLERANCE, harmonic_period, strobe_point
 
@@ -62,12 +63,25 @@ def linear_frf(scenario: Scenario, frequencies: Sequence[float] | np.ndarray,
     -------
     ndarray, complex, (n_frequencies, n_points)
         ``H`` in m per unit of ``excitation.amplitude`` (times ``excitation.scale``).
+
+    Raises
+    ------
+    ParameterError
+        A point off the beam, or a negative or non-finite frequency.
     """
     pk, _ = _free_state(scenario)
     x = np.asarray([strobe_point(scenario)] if points is None else points, dtype=float)
+    L = scenario.beam.length
+    bad = ~np.isfinite(x) | (x < 0.0) | (x > L * (1.0 + 1e-12))
+    if x.ndim != 1 or bad.any():
+        shown = x[bad][0] if x.ndim == 1 else x
+        raise ParameterError(f"points: {shown} m is not a position on the beam [0, {L:g}] m (a 1-D list)")
+    f = np.asarray(frequencies, dtype=float)
+    if f.ndim > 1 or not np.all(np.isfinite(f)) or np.any(f < 0.0):
+        raise ParameterError("frequencies: expected finite frequencies >= 0 [Hz] in a 1-D list")
     W = pk.rows(x)[0]  # (n_x, n_modes), free state
     om, dec, pw = pk.om[0], pk.dec[0], pk.pw[0]
-    Om = 2.0 * np.pi * np.asarray(frequencies, dtype=float)[:, None]
+    Om = 2.0 * np.pi * np.atleast_1d(f)[:, None]
     modal = pw[None, :] / (om[None, :] ** 2 - Om**2 + 2j * dec[None, :] * Om)
     return modal @ W.T
 

@@ -164,8 +164,9 @@ def bifurcation_map(
         raise ParameterError(f"sweep: expected 'up' or 'down' along x, got {sweep!r}")
     if workers is not None and scheduler is not None:
         raise ParameterError("workers and scheduler exclude each other")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
-        raise ParameterError(f"workers: expected a whole number >= 0, got {workers!r}")
+    from ..sweeps.cluster import check_workers
+
+    check_workers(workers, "workers")
     settle = count("settle_periods", settle_periods, 0)
     record = count("record_periods", record_periods, 2)
     harmonic_period(scenario)

@@ -177,7 +177,7 @@ class StroboscopicMap:
 
     def solve(self, x: np.ndarray, duration: float | None = None) -> Solution:
         """The exact solution from state ``x`` (free-state coordinates) at the section, over ``duration``."""
-        from ..model.loading import InitialCondition
+        from ..model.starting import InitialCondition
         from ..solver.engine import integrate
 
         x = np.asarray(x, dtype=float)

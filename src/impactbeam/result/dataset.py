@@ -97,10 +97,11 @@ def result_dataset(result: Any) -> Any:
     )
     for name, arr in result.energy.items():
         ds[f"energy_{name}"] = ("time", arr, {"units": "J", "long_name": f"energy: {name.replace('_', ' ')}"})
-    if "moment" in result.fields:
-        ds["bending_moment"] = (("time", "point"), result.bending_moment(result.points, result.time).T,
+    fields = result._field_grid  # the same arrays as the CSV and Parquet tables
+    if "moment" in fields:
+        ds["bending_moment"] = (("time", "point"), fields["moment"],
                                 {"units": "N m", "long_name": "bending moment EI w''"})
-    if "stress" in result.fields:
-        ds["bending_stress"] = (("time", "point"), result.bending_stress(result.points, result.time).T,
+    if "stress" in fields:
+        ds["bending_stress"] = (("time", "point"), fields["stress"],
                                 {"units": "Pa", "long_name": "outer-fibre bending stress M c / I"})
     return ds

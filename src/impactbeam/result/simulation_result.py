@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._io import RESULT_SUFFIXES, atomic_path
+from .._io import RESULT_SUFFIXES, atomic_path, write_netcdf
 from .._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
 from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
@@ -23,8 +23,11 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SimulationResult", "write_result", "RESULT_SUFFIXES", "sample_count", "memory_limit", "check_memory", "output_bytes",
-    "check_output_size",
+    "check_output_size", "STRESS_METRIC_UNITS",
 ]
+
+#: Units of the metrics that ``[output] fields = ["stress"]`` adds to :meth:`SimulationResult.metrics`.
+STRESS_METRIC_UNITS = {"max_bending_stress": "Pa", "max_bending_stress_time": "s", "max_bending_stress_position": "m"}
 
 _CHUNK = 65536  # samples evaluated per call of the compiled sampler
 
@@ -345,7 +348,7 @@ class SimulationResult:
         -------
         ndarray, [m]
         """
-        x = np.atleast_1d(np.asarray(x, dtype=float))
+        x = _one_dimensional("x", x)
         L = self.beam.length
         bad = ~np.isfinite(x) | (x < 0.0) | (x > L * (1.0 + 1e-12))
         if bad.any():
@@ -373,7 +376,7 @@ class SimulationResult:
             A point off the beam or a time outside ``[0, end_time]``.
         """
         x = self.check_points(x)
-        t = self.solution.check_times(t, self.end_time)
+        t = self.solution.check_times(_one_dimensional("t", t), self.end_time)
         return self.solution.sample(x, t).w.T
 
     def velocity(self, x: Any, t: Any) -> np.ndarray:
@@ -392,7 +395,7 @@ class SimulationResult:
             See :meth:`displacement` for NaN and errors.
         """
         x = self.check_points(x)
-        t = self.solution.check_times(t, self.end_time)
+        t = self.solution.check_times(_one_dimensional("t", t), self.end_time)
         return self.solution.sample(x, t).w_t.T
 
     def bending_moment(self, points: Any, times: Any, *, static_correction: bool = True) -> np.ndarray:
@@ -413,6 +416,7 @@ class SimulationResult:
         """
         from .stress import bending_moment
 
+        self._require_exact("bending_moment")
         return bending_moment(self, points, times, static_correction=static_correction)
 
     def bending_stress(self, points: Any, times: Any, *, static_correction: bool = True) -> np.ndarray:
@@ -433,7 +437,26 @@ class SimulationResult:
         """
         from .stress import bending_stress
 
+        self._require_exact("bending_stress")
         return bending_stress(self, points, times, static_correction=static_correction)
+
+    def _require_exact(self, what: str) -> None:
+        """ParameterError for a moment or stress of a ``method = "ivp"`` run (its solution has no state space)."""
+        if self.options.get("method", "exact") != "exact":
+            raise ParameterError(
+                f'{what}: moments and stresses come from the exact solution; this result was computed with '
+                f'method = "{self.options.get("method")}" (the reference path): run simulate(..., method="exact")'
+            )
+
+    @functools.cached_property
+    def _field_grid(self) -> dict[str, np.ndarray]:
+        """The ``[output] fields`` beyond w and w_t on the output grid: ``moment`` [N m], ``stress`` [Pa], (n_t, n_p)."""
+        out = {}
+        if "moment" in self.fields:
+            out["moment"] = self.bending_moment(self.points, self.time).T
+        if "stress" in self.fields:
+            out["stress"] = self.bending_stress(self.points, self.time).T
+        return out
 
     def final_state(self) -> ModalState:
         """The modal state at the end of the run, to start another from (``simulate(..., start=)``).
@@ -462,12 +485,30 @@ class SimulationResult:
         from .metrics import compute_metrics
 
         out = compute_metrics(self, impacts=impacts)
+        self._warn_unresolved(out)
         if "stress" in self.fields:
+            self._require_exact("max_bending_stress")
             from .stress import max_bending_stress
 
             value, when, where = max_bending_stress(self)
             out.update(max_bending_stress=value, max_bending_stress_time=when, max_bending_stress_position=where)
         return out
+
+    def _warn_unresolved(self, metrics: dict[str, Any]) -> None:
+        """Warn when the response is too small for the extrema's absolute tolerance (1e-12 of the length)."""
+        peak = max((abs(v) for v in (metrics.get("max_response"), metrics.get("min_response")) if v is not None),
+                   default=0.0)
+        sc = self.scenario
+        driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
+        if driven and peak < 1e-9 * self.beam.length:
+            from .._warnings import emit_user_level_warning
+
+            emit_user_level_warning(
+                f"metrics: the response is only ~{peak:.2g} m, below 1e-9 of the beam length; the extrema behind "
+                f"max_response, t_max and min_response are located to {1e-12 * self.beam.length:.2g} m "
+                "(1e-12 L), so they are not resolved: scale the load up (the model is linear until contact) or "
+                "read the response from displacement()"
+            )
 
     @property
     def fields(self) -> tuple[str, ...]:
@@ -504,7 +545,8 @@ class SimulationResult:
         return result_dataset(self)
 
     def to_dataframe(self):
-        """Wide table: time, w and w_t at each point, contact force per contactor, energies."""
+        """Wide table: time, w and w_t at each point, contact force per contactor, energies, and the
+        bending moment ``M`` and stress ``sigma`` at each point when ``[output] fields`` asks for them."""
         import pandas as pd
 
         cols: dict[str, np.ndarray] = {"time [s]": self.time}
@@ -517,6 +559,9 @@ class SimulationResult:
             cols[f"engaged_{i}"] = self.engaged[:, i]
         for name, arr in self.energy.items():
             cols[f"energy_{name} [J]"] = arr
+        for name, (label, unit) in (("moment", ("M", "N m")), ("stress", ("sigma", "Pa"))):
+            for j, x in enumerate(self.points if name in self._field_grid else ()):
+                cols[f"{label}(x={x:.6g}) [{unit}]"] = self._field_grid[name][:, j]
         return pd.DataFrame(cols)
 
     def plot(self, path: str | os.PathLike | None = None, **kwargs):
@@ -538,6 +583,17 @@ class SimulationResult:
         return plot_result(self, path, **kwargs)
 
 
+def _one_dimensional(name: str, values: Any) -> np.ndarray:
+    """``values`` as a 1-D float array; ParameterError naming ``name`` for a 2-D array or a non-number."""
+    try:
+        arr = np.atleast_1d(np.asarray(values, dtype=float))
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected numbers, got {type(values).__name__}") from None
+    if arr.ndim != 1:
+        raise ParameterError(f"{name}: expected a number or a 1-D sequence, got an array of shape {arr.shape}")
+    return arr
+
+
 def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     """Write the full result to ``.nc`` (netCDF4/HDF5), ``.csv`` or ``.parquet``, atomically.
 
@@ -557,6 +613,8 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
         An unsupported suffix.
     ResourceError
         The sampled histories would exceed the memory limit.
+    WriteError
+        The file could not be written (a read-only or full file system): nothing is left behind.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -567,11 +625,13 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
     path.parent.mkdir(parents=True, exist_ok=True)
     check_output_size(result.time.size, result.points.size, len(result.contactors), result.solution.n_modes)
+    if suffix == ".nc":
+        write_netcdf(result.to_xarray(), path)
+        return path
+    table = result.to_dataframe()
     with atomic_path(path) as tmp:
-        if suffix == ".nc":
-            result.to_xarray().to_netcdf(tmp, engine="h5netcdf")
-        elif suffix == ".csv":
-            result.to_dataframe().to_csv(tmp, index=False)
+        if suffix == ".csv":
+            table.to_csv(tmp, index=False)
         else:
-            result.to_dataframe().to_parquet(tmp, index=False)
+            table.to_parquet(tmp, index=False)
     return path

@@ -11,7 +11,8 @@ import numpy as np
 
 from ..model.beam import Beam, Contactor
 from ..exceptions import ScenarioError
-from ..model.loading import Excitation, InitialCondition, Preload, Profile
+from ..model.loading import Excitation
+from ..model.starting import InitialCondition, Preload, Profile
 from ..model.fatigue import FatigueSpec
 from ..model.psd import PowerSpectralDensity
 from ..model import BASES, Damping, SolverOptions
@@ -280,6 +281,16 @@ def _parse_initial(raw: Mapping[str, Any], beam: Beam, base_dir: Path | None = N
                 "initial.position: has no effect without initial.tip_displacement", key="initial.position"
             )
         position = _on_beam("initial.position", to_si(ini["position"], "length", "initial.position"), beam.length)
+    if tip is not None and tip != 0.0:
+        x0 = beam.length if position is None else position
+        held = beam.fixed_at(x0)
+        if held is not None:
+            key = "initial.position" if position is not None else "initial.tip_displacement"
+            raise ScenarioError(
+                f"{key}: the deflection is imposed at x = {x0:g} m, at {held} where w = 0; no static load "
+                "can move that point: give initial.position on the free part of the beam",
+                key=key,
+            )
     modal = {
         name: _float_list(f"initial.{name}", ini[name]) if name in ini else None
         for name in ("modal_displacement", "modal_velocity")
@@ -375,24 +386,38 @@ def _parse_output(raw: Mapping[str, Any], beam: Beam, contactors: tuple[Contacto
     if not values:
         raise ScenarioError(f"output.{name}: the list is empty", key=f"output.{name}")
     points = []
+    seen: set[float] = set()
     for i, v in enumerate(values):
         key = f"output.{name}.{i}"
         x = _ratio(key, v) * beam.length if name == "point_ratios" else to_si(v, "length", key)
         x = _on_beam(key, x, beam.length)
-        if x in points:
+        if x in seen:
             raise ScenarioError(f"{key}: {_fmt_m(x)} is listed twice", key=key)
+        seen.add(x)
         points.append(x)
     return tuple(points)
 
 
-def _parse_output_fields(raw: Mapping[str, Any]) -> tuple[str, ...]:
-    """``[output] fields``: the fields of result files by their canonical names, each once."""
+def _parse_output_fields(raw: Mapping[str, Any], beam: Beam) -> tuple[str, ...]:
+    """``[output] fields``: the fields of result files by their canonical names, each once.
+
+    The stress needs the outer-fibre distance ``height / 2`` of every section:
+    a section given as area and second moment has none, so the field is
+    refused rather than written as NaN.
+    """
     values = raw.get("output", {}).get("fields", [])
     out: list[str] = []
     for i, v in enumerate(values):
+        key = f"output.fields.{i}"
         v = OUTPUT_FIELD_ALIASES.get(v, v) if isinstance(v, str) else v
-        name = _choice(f"output.fields.{i}", v, OUTPUT_FIELDS)
+        name = _choice(key, v, OUTPUT_FIELDS)
         if name in out:
-            raise ScenarioError(f"output.fields.{i}: {name!r} is listed twice", key=f"output.fields.{i}")
+            raise ScenarioError(f"{key}: {name!r} is listed twice", key=key)
+        if name == "stress" and any(p.height is None for p in beam.pieces()):
+            raise ScenarioError(
+                f'{key}: "stress" needs the outer-fibre distance (height / 2), and a section given as area and '
+                "second_moment has none; give width and height, or ask for \"moment\" (M; the stress is M c / I)",
+                key=key,
+            )
         out.append(name)
     return tuple(out)

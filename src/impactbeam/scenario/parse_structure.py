@@ -215,5 +215,7 @@ def _parse_contactors(raw: Mapping[str, Any], beam: Beam) -> tuple[Contactor, ..
         if "restitution" in c:
             restitution = to_si(c["restitution"], "dimensionless", f"{prefix}.restitution")
         with _relabel(prefix, (("contactor.", f"{prefix}."),)):
-            out.append(Contactor(position, stiffness, gap, side, damping, restitution))  # type: ignore[arg-type]
+            contactor = Contactor(position, stiffness, gap, side, damping, restitution)  # type: ignore[arg-type]
+            contactor.check_on(beam, prefix)
+            out.append(contactor)
     return tuple(out)

@@ -27,7 +27,8 @@ from collections.abc import Callable
 import numpy as np
 
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, InitialCondition, Preload, time_pieces
+from ..model.loading import Excitation, time_pieces
+from ..model.starting import InitialCondition, Preload
 from ..modal import mode_set
 from . import _loop
 from ..model import Damping, SolverOptions

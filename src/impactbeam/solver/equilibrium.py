@@ -1,6 +1,6 @@
 """The static equilibrium under a constant preload, with the contactors it engages.
 
-A preload (:class:`~impactbeam.model.loading.Preload`: gravity, a constant
+A preload (:class:`~impactbeam.model.starting.Preload`: gravity, a constant
 base acceleration or a point force) acts during the whole run; with
 ``initial.equilibrium = true`` the run starts from the static equilibrium of
 the run's own model under it. That is a contact problem: each contactor is a
@@ -57,7 +57,8 @@ import scipy.optimize
 from ..exceptions import ParameterError
 from ..modal import static_state
 from ..model.beam import Beam, Contactor, InteriorSpring
-from ..model.loading import Preload, spatial_projection
+from ..model.loading import spatial_projection
+from ..model.starting import Preload
 
 __all__ = ["Equilibrium", "ContinuumEquilibrium", "preload_weights", "modal_equilibrium", "continuum_equilibrium"]
 

@@ -1,7 +1,7 @@
 """The state at t = 0 in the run's basis: fields projected in the kinetic inner product, or the static equilibrium.
 
 The one rule for every initial condition of ``[initial]``
-(:class:`~impactbeam.model.loading.InitialCondition`), for the paper's
+(:class:`~impactbeam.model.starting.InitialCondition`), for the paper's
 per-state modes and for the shared Ritz basis alike. A displacement field
 ``u(x)`` and a velocity field ``v(x)`` along the beam become modal
 coordinates by the projection that defines them (paper eq. 12 with the
@@ -61,7 +61,7 @@ from .._warnings import emit_user_level_warning
 from ..exceptions import ParameterError
 from ..modal import static_state
 from ..model.beam import Beam, Contactor
-from ..model.loading import InitialCondition, Preload, Profile
+from ..model.starting import InitialCondition, Preload, Profile
 from .equilibrium import continuum_equilibrium, modal_equilibrium
 
 __all__ = ["RESIDUAL_WARNING", "Field", "initial_coordinates", "project_field"]

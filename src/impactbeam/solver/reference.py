@@ -43,7 +43,8 @@ from scipy.optimize import brentq
 
 from ..model.beam import Beam, Contactor
 from ..exceptions import SimulationError
-from ..model.loading import Excitation, InitialCondition, Preload
+from ..model.loading import Excitation
+from ..model.starting import InitialCondition, Preload
 from .engine import make_space
 from .initial import initial_coordinates
 from .solution import Event, PiecewiseSolution, Samples

@@ -22,7 +22,8 @@ import numpy as np
 from ..exceptions import ParameterError
 from ..model import Damping
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, Preload, spatial_projection
+from ..model.loading import Excitation, spatial_projection
+from ..model.starting import Preload
 from .ritz import RitzBasis, ritz_basis
 from .states import ProblemSpace, StateModel
 

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, Preload, spatial_projection
+from ..model.loading import Excitation, spatial_projection
+from ..model.starting import Preload
 from ..modal import ModeSet, mode_set
 from ..model import Damping
 from .damping import dashpot_coefficient, state_damping_matrix

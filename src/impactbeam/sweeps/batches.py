@@ -13,7 +13,7 @@ import numpy as np
 
 from ..exceptions import ImpactBeamError
 from ..scenario import parse_scenario
-from .spec import FAILED, SweepSpec, _DEFAULT_MAX_BATCH, _plain
+from .spec import FAILED, SweepSpec, _plain, default_batch_size
 
 __all__ = ["default_batch_size", "run_batch"]
 
@@ -41,15 +41,6 @@ def _chunk_shape(spec: SweepSpec, batch_size: int) -> tuple[int, ...]:
         if chunk[i] < shape[i]:
             break
     return tuple(chunk)
-
-
-def default_batch_size(n_cases: int) -> int:
-    """Cases per batch when not given: about 32 batches, at most 100 cases each.
-
-    It does not depend on the number of workers, so the same sweep gives the
-    same store layout on a laptop and on a cluster.
-    """
-    return max(1, min(_DEFAULT_MAX_BATCH, math.ceil(n_cases / 32)))
 
 
 def _regions(shape: tuple[int, ...], chunk: tuple[int, ...]) -> Iterator[tuple[slice, ...]]:

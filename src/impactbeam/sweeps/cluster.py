@@ -15,7 +15,45 @@ from typing import Any
 from .._optional import require
 from ..exceptions import ParameterError
 
-__all__ = ["dask_client", "worker_config"]
+__all__ = ["WORKER_BYTES", "check_workers", "dask_client", "worker_config"]
+
+#: Memory of one worker of the local cluster once it has run a case: its process (~190 MiB
+#: resident after one Case-3 simulation, measured) and its nanny (~60 MiB).
+WORKER_BYTES = 256 << 20
+#: Most worker processes per core: the cases are CPU-bound, more only wait for a core.
+WORKERS_PER_CORE = 4
+
+
+def check_workers(workers: int | None, option: str = "--workers") -> None:
+    """Refuse a local cluster larger than the machine: more than 4 per core or more than the memory holds.
+
+    Parameters
+    ----------
+    workers : int or None
+        Requested worker processes (None: one per core, always accepted).
+    option : str
+        The option named in the error.
+
+    Raises
+    ------
+    ParameterError
+        With the estimate and the largest count accepted.
+    """
+    if workers is None:
+        return
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        raise ParameterError(f"{option}: must be an integer >= 0, got {workers!r}")
+    from .._memory import memory_limit
+
+    cores = os.cpu_count() or 1
+    limit = memory_limit()
+    most = max(1, min(WORKERS_PER_CORE * cores, limit // WORKER_BYTES))
+    if workers > most:
+        raise ParameterError(
+            f"{option}: {workers} worker processes would need about {workers * WORKER_BYTES / 2**30:.3g} GiB "
+            f"({WORKER_BYTES >> 20} MiB each; the limit is {limit / 2**30:.3g} GiB) on {cores} core"
+            f"{'s' if cores != 1 else ''}; use at most {most} (0 runs in this process)"
+        )
 
 
 def worker_config() -> dict[str, Any]:
@@ -67,6 +105,7 @@ def dask_client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
         except (OSError, TimeoutError) as exc:
             raise ParameterError(f'--scheduler: cannot connect to "{scheduler}": {exc}') from None
     else:
+        check_workers(workers)
         with dask.config.set(worker_config()):
             cluster = distributed.LocalCluster(
                 n_workers=workers or os.cpu_count() or 1,

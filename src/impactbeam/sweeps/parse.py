@@ -12,12 +12,13 @@ import numpy as np
 
 from ..exceptions import ScenarioError
 from ..result.metrics import METRIC_UNITS
+from ..result.simulation_result import STRESS_METRIC_UNITS
 from ..scenario import Scenario, load_scenario, parse_scenario, path_dimension
 from ..scenario.schema import describe_value
 from ..units import to_si
 from .spec import DESIGNS, DISTRIBUTIONS, Histories, SweepParameter, SweepSpec
 
-__all__ = ["load_sweep", "parse_sweep"]
+__all__ = ["load_sweep", "metric_units", "parse_sweep"]
 
 
 _TOP_KEYS = ("base", "design", "samples", "seed", "parameters", "outputs", "name", "description")
@@ -277,7 +278,7 @@ def parse_sweep(
     for k in outputs:
         if k not in _OUTPUT_KEYS:
             raise err(f"outputs.{k}", f"unknown key (use {', '.join(_OUTPUT_KEYS)})")
-    metrics = _metric_names(err, outputs.get("metrics", "all"))
+    metrics = _metric_names(err, outputs.get("metrics", "all"), base)
     histories = None
     if "histories" in outputs:
         histories = _histories(err, outputs["histories"], base)
@@ -290,7 +291,8 @@ def parse_sweep(
         raise err("name", f"expected a string, got {describe_value(name)}")
     spec = SweepSpec(base, design, tuple(params), samples, seed, metrics, histories, src, name, statistics)
     if histories is not None:
-        spec.history_times()  # checks a bounded end time
+        spec.history_times()  # checks a bounded end time and the number of samples
+    spec.check_memory()
     return spec
 
 
@@ -302,17 +304,25 @@ def _check_alternatives(err: _Errors, paths: list[str]) -> None:
                 raise err(f'parameters."{p}"', f'and "{p[: -len(a)] + b}" set the same field; vary one of them')
 
 
-def _metric_names(err: _Errors, value: Any) -> tuple[str, ...]:
+def metric_units(base: Scenario) -> dict[str, str]:
+    """The scalar metrics a sweep of ``base`` can store and their units: the response metrics, and the
+    maximum bending stress (its value, time and place) when the base asks for ``[output] fields = ["stress"]``."""
+    return {**METRIC_UNITS, **(STRESS_METRIC_UNITS if "stress" in base.output_fields else {})}
+
+
+def _metric_names(err: _Errors, value: Any, base: Scenario) -> tuple[str, ...]:
+    known = metric_units(base)
     if value == "all":
-        return tuple(METRIC_UNITS)
+        return tuple(known)
     if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
         raise err("outputs.metrics", f'expected "all" or a list of metric names, got {describe_value(value)}')
     for v in value:
-        if v not in METRIC_UNITS:
-            raise err("outputs.metrics", f'unknown metric "{v}" (use {", ".join(METRIC_UNITS)})')
+        if v not in known:
+            hint = ' (add [output] fields = ["stress"] to the base scenario)' if v in STRESS_METRIC_UNITS else ""
+            raise err("outputs.metrics", f'unknown metric "{v}" (use {", ".join(known)}){hint}')
     if len(set(value)) != len(value):
         raise err("outputs.metrics", "a metric is listed twice")
-    return tuple(v for v in METRIC_UNITS if v in value)  # canonical order
+    return tuple(v for v in known if v in value)  # canonical order
 
 
 def _histories(err: _Errors, value: Any, base: Scenario) -> Histories:
@@ -346,13 +356,15 @@ def load_sweep(path: str | os.PathLike[str]) -> SweepSpec:
     path : str or path-like
         The sweep file (TOML).
     """
+    from .._io import read_text_file
+    from ..scenario.core import SCENARIO_MEMORY_FACTOR
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(f"{p}: no such sweep file", key="sweep") from None
-    except OSError as exc:
-        raise ScenarioError(f"{p}: cannot read the sweep file: {exc.strerror or exc}", key="sweep") from None
+
+    def fail(detail: str) -> ScenarioError:
+        return ScenarioError(f"{p}: the sweep file {detail}", key="sweep")
+
+    text = read_text_file(p, fail, not_found="does not exist (no such sweep file)", memory_factor=SCENARIO_MEMORY_FACTOR)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -13,11 +13,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
+from .._io import WriteError, check_writable, write_error
 from .._optional import require
 from ..exceptions import ImpactBeamError, ParameterError, SimulationError
 if TYPE_CHECKING:
     import xarray as xr
-from .cluster import dask_client
+from .cluster import check_workers, dask_client
 from .batches import (
     _Batch,
     _chunk_shape,
@@ -177,18 +178,35 @@ def run_sweep(
         raise ParameterError(f'on_error: must be "record" or "raise", got {on_error!r}')
     if workers is not None and scheduler is not None:
         raise ParameterError("give either workers (a local cluster) or scheduler (a running one), not both")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
-        raise ParameterError(f"workers: must be an integer >= 0, got {workers!r}")
+    check_workers(workers, "workers")
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise ParameterError(f"batch_size: must be a positive integer, got {batch_size!r}")
     out_path = Path(out) if out is not None else None
     chunk = _chunk_shape(spec, batch_size or default_batch_size(spec.n_cases))
+    spec.check_memory(int(np.prod(chunk)))
     if out_path is None:
         _check_in_memory(spec)
-    if out_path is not None and not out_path.parent.is_dir():
+    else:
+        _check_store_path(out_path)
+    try:
+        with _StoreLock(out_path):
+            return _run_locked(spec, out_path, chunk, workers, scheduler, progress, on_error)
+    except OSError as exc:  # a read-only or full file system: one line; finished batches stay in the store
+        err = write_error(out_path or "the sweep", exc)
+        raise WriteError(err.path, f"{err.reason} (the batches finished before are kept in the store; "
+                                   "free space and run the same sweep again)", errno_=err.errno) from None
+
+
+def _check_store_path(out_path: Path) -> None:
+    """The store is a Zarr directory in an existing, writable directory (checked before any work)."""
+    if out_path.suffix and out_path.suffix.lower() != ".zarr":
+        raise ParameterError(
+            f'--out: "{out_path}": a sweep is stored as a Zarr directory, not a {out_path.suffix} file; give a '
+            f'name ending in .zarr (then xarray.open_zarr(...).to_netcdf(...) writes a netCDF copy)'
+        )
+    if not out_path.parent.is_dir():
         raise ParameterError(f'--out: directory "{out_path.parent}" does not exist')
-    with _StoreLock(out_path):
-        return _run_locked(spec, out_path, chunk, workers, scheduler, progress, on_error)
+    check_writable("--out", out_path)
 
 
 def _check_in_memory(spec: SweepSpec) -> None:

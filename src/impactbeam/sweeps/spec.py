@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 import numpy as np
 
+from .._memory import MAX_OUTPUT_SAMPLES
 from ..exceptions import ParameterError, ScenarioError
 from ..scenario import Scenario
 from ..units import DIMENSIONS
@@ -31,6 +32,7 @@ __all__ = [
     "STATUS_CODES",
     "SweepParameter",
     "SweepSpec",
+    "default_batch_size",
 ]
 
 
@@ -51,6 +53,10 @@ STATUS_CODES = {0: "reached end_time", 1: "stopped by the chattering guard", FAI
 
 _FORMAT_VERSION = 1
 _DEFAULT_MAX_BATCH = 100
+#: Peak bytes per sample and parameter of a sampled design: drawing (Latin hypercube, its
+#: permutations, the inverse CDFs) and the store's coordinates; measured 67 with 2e6 samples of
+#: 2 parameters (peak RSS).
+SAMPLE_BYTES = 80
 
 # Parameters that determine the mode sets (beam and its sections, supports, point masses,
 # permanent springs, contact spring positions and stiffnesses, number of modes): cases
@@ -289,8 +295,49 @@ class SweepSpec:
         if not math.isfinite(end):
             raise ScenarioError("outputs.histories: solver.end_time is sampled without bound", key="outputs.histories")
         dt = self.histories.time_step
+        if end / dt > MAX_OUTPUT_SAMPLES:
+            raise ScenarioError(
+                f"outputs.histories.time_step: {dt:g} s gives {end / dt:.3g} samples of each history up to "
+                f"solver.end_time = {end:g} s, too many (max {MAX_OUTPUT_SAMPLES:.0e}); use a larger time step",
+                key="outputs.histories.time_step",
+            )
         n = int(math.floor(end / dt * (1 + 1e-12))) + 1
         return np.arange(n) * dt
+
+    def check_memory(self, batch_cases: int | None = None) -> None:
+        """Refuse, before any work, a sweep whose samples or history batches exceed the memory limit.
+
+        The sampled values (drawing them and the store's coordinates:
+        :data:`SAMPLE_BYTES` per sample and parameter, measured) and, with
+        histories, one batch of them in a worker (the batch's array, one
+        case's evaluation and the compressed chunk: three copies).
+
+        Parameters
+        ----------
+        batch_cases : int, optional
+            Cases per batch (default: the default batch size).
+        """
+        from .._memory import check_memory
+
+        if not self.is_grid:
+            n, d = int(self.samples or 0), len(self.parameters)
+            check_memory(n * (SAMPLE_BYTES * d + 16), f"samples: drawing {n} samples of {d} parameter"
+                         f"{'s' if d != 1 else ''}", "draw fewer samples")
+        if self.histories is not None:
+            batch = batch_cases or default_batch_size(self.n_cases)
+            per_case = 8.0 * self.history_times().size * len(self.histories.points)
+            check_memory(3.0 * batch * per_case, f"outputs.histories: a batch of {batch} cases of "
+                         f"{self.history_times().size} samples at {len(self.histories.points)} points",
+                         "use a larger outputs.histories.time_step, fewer points or a smaller --batch-size")
+
+
+def default_batch_size(n_cases: int) -> int:
+    """Cases per batch when not given: about 32 batches, at most 100 cases each.
+
+    It does not depend on the number of workers, so the same sweep gives the
+    same store layout on a laptop and on a cluster.
+    """
+    return max(1, min(_DEFAULT_MAX_BATCH, math.ceil(n_cases / 32)))
 
 
 def _plain(v: Any) -> Any:

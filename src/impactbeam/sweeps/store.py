@@ -14,9 +14,9 @@ import numpy as np
 from .._io import pid_alive
 from .._optional import require
 from ..exceptions import ParameterError
-from ..result.metrics import METRIC_UNITS
 if TYPE_CHECKING:
     import xarray as xr
+from .parse import metric_units
 from .spec import NOT_RUN, STATUS_CODES, SweepSpec
 
 __all__ = []
@@ -55,8 +55,9 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
             coords[p.path] = xr.Variable(("case",), x[:, j].copy(), attrs)
     data: dict[str, Any] = {}
     enc: dict[str, Any] = {}
+    units = metric_units(spec.base)
     for m in spec.metrics:
-        data[m] = xr.Variable(dims, da.full(shape, np.nan, chunks=-1), {"units": METRIC_UNITS[m], "long_name": m.replace("_", " ")})
+        data[m] = xr.Variable(dims, da.full(shape, np.nan, chunks=-1), {"units": units[m], "long_name": m.replace("_", " ")})
         enc[m] = {"chunks": chunk, "fill_value": np.nan}
     data["status"] = xr.Variable(
         dims,
@@ -218,8 +219,13 @@ class _StoreLock:
                     f'{holder.get("host")}, since {when}); wait for it to finish, or remove "{self.path}" if '
                     "that process is gone"
                 ) from None
-            with os.fdopen(fd, "w") as fh:
-                json.dump(me, fh)
+            try:
+                with os.fdopen(fd, "w") as fh:
+                    json.dump(me, fh)
+            except OSError:  # a full disk: the lock was created empty; do not leave it behind
+                with contextlib.suppress(OSError):
+                    os.unlink(self.path)
+                raise
             return self
         raise ParameterError(f'--out: cannot take the lock "{self.path}"')
 
