@@ -23,7 +23,7 @@ Method
   diagonal of K; an infinite one removes the DOF (constraint elimination, never
   a penalty number).  Interior translational springs ``(x, k)`` are handled
   the same way at the node placed exactly at ``x``.  The strain energy
-  ``1/2 Kt W'(0)^2`` etc. reproduces the boundary conditions of DESIGN.md s.1.
+  ``1/2 Kt W'(0)^2`` etc. reproduces the boundary conditions of the paper (after its eq. 5).
 * Modes: ``scipy.linalg.eigh(K_r, M_r)`` on the reduced matrices; eigenvectors
   are mass-normalised (``phi^T M phi = 1``, i.e. ``rhoA int W^2 dx = 1`` up to
   discretisation); rigid-body modes are reported with omega = 0.

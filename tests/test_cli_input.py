@@ -1,4 +1,4 @@
-"""The command line's handling of bad input (DESIGN.md section 3, last bullet).
+"""The command line's handling of bad input (the scenario contract: bad input exits 2 naming the key).
 
 The real console script is run in a subprocess, as a user would run it: bad
 input must exit with status 2 and print exactly one line on stderr,
@@ -76,7 +76,7 @@ BAD = [
 def test_bad_scenario_exits_2(
     tmp_path: Path, scenario_file, command: str, text: str, files: dict[str, str], needle: str
 ) -> None:
-    # Reason: DESIGN.md section 3 — status 2, one clear line naming the key, no
+    # Reason: the contract for bad input: status 2, one clear line naming the key, no
     # traceback, and (simulate --out) no output file left behind.
     for name, content in files.items():
         (tmp_path / name).write_text(content, encoding="utf-8")

@@ -29,6 +29,7 @@ API_MODULES = (
     "impactbeam.solver.solution",
     "impactbeam.result",
     "impactbeam.result.simulation_result",
+    "impactbeam.result.files",
     "impactbeam.result.metrics",
     "impactbeam.result.stress",
     "impactbeam.plot",

@@ -25,7 +25,7 @@ INF = math.inf
 EPS = np.finfo(float).eps
 CLAMPED, PINNED, FREE, SLIDING = (INF, INF), (INF, 0.0), (0.0, 0.0), (0.0, INF)
 
-# the paper's specimen (DESIGN.md, Table 1 case 3)
+# the paper's specimen (the paper's Table 1, case 3)
 SPEC_L = 0.10920
 _b, _h = 9.93e-3, 3.03e-3
 SPEC_EI = 1834e6 * _b * _h**3 / 12
@@ -432,7 +432,7 @@ def test_step_force_settles_to_static_cantilever():
 
 def test_zero_gap_contact_under_load_starts_at_time_zero():
     # Zero gap, at rest, a load pushing into the contactor: an impact at t = 0
-    # (DESIGN.md metric convention), and the contact holds.
+    # (the metrics' convention, docs/metrics.md), and the contact holds.
     c = [dict(position=0.5, stiffness=50.0, gap=0.0, side="below")]
     r = fr.fe_transient(1.0, 1.0, 1.0, left=CLAMPED, right=FREE, contactors=c, damping=(0.3, 0.3),
                         load=dict(kind="point_force", position=1.0, amplitude=-1.0, shape="step"),

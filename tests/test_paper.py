@@ -116,7 +116,7 @@ def test_published_values_as_printed():
 
 
 def test_paper_metrics_is_gap_function_of_project_metrics():
-    """d = u + c (DESIGN.md sign convention): recomputed from the raw samples."""
+    """d = u + c (the model's sign convention): recomputed from the raw samples."""
     sc = paper.case(3)
     res = ib.simulate(sc)
     pm = paper.paper_metrics(res)

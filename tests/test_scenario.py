@@ -1,6 +1,6 @@
 """Scenario files: parsing, units, defaults, dotted paths, round trips and bad input.
 
-The scenario layer is the project's input boundary (DESIGN.md section 3):
+The scenario layer is the project's input boundary (docs/scenario reference and the CLI contract):
 every value a user writes must reach the data classes in SI, and every
 mistake must come back as a ScenarioError that names the dotted key.
 """
@@ -216,7 +216,7 @@ end_time = "50 ms"
 
 
 def test_defaults() -> None:
-    # Reason: DESIGN.md section 3 and examples/README.md promise these defaults.
+    # Reason: examples/README.md and the scenario reference promise these defaults.
     sc = parse_scenario(tomllib.loads(BEAM + '[[contactors]]\nposition = 0.05\nstiffness = 1e3\n'))
     assert sc.beam.left.name == "clamped" and sc.beam.right.name == "free"
     c = sc.contactors[0]
@@ -511,7 +511,7 @@ BAD = [
 
 @pytest.mark.parametrize(("text", "files", "key"), BAD)
 def test_bad_input(tmp_path: Path, scenario_file, text: str, files: dict[str, str], key: str) -> None:
-    # Reason: DESIGN.md section 3 — bad input is reported naming the key, never a
+    # Reason: bad input is reported naming the key, never a
     # traceback or a silent default. ScenarioError is a ParameterError and a ValueError.
     for name, content in files.items():
         (tmp_path / name).write_text(content, encoding="utf-8")

@@ -248,7 +248,7 @@ def test_distributed_step_force_settles_to_the_static_deflection():
 
 
 def test_base_acceleration_equals_the_distributed_force_it_stands_for():
-    # Base acceleration ug'' is the load -rho A ug'' (DESIGN.md s.1): identical responses.
+    # Base acceleration ug'' is the load -rho A ug'': identical responses.
     sc = _sc("case03")
     ex = sc.excitation
     q = ib.Excitation("distributed_force", "half_sine", -sc.beam.mass_per_length * ex.amplitude, ex.duration)
@@ -414,7 +414,7 @@ def test_two_contactors_exact_vs_ivp():
 
 @pytest.mark.parametrize("method", ["exact", "ivp"])
 def test_zero_gap_with_load_toward_the_contactor_impacts_at_zero(method):
-    # DESIGN.md s.3: a contact under way at t = 0 counts as an impact beginning at 0.
+    # A contact under way at t = 0 counts as an impact beginning at 0.
     # Case 9 (zero gap, contactor above) with the pulse reversed (-15 g pushes +w).
     sc = _sc("case09")
     ex = sc.excitation

@@ -5,7 +5,7 @@ implicit average-acceleration Newmark with crossings located inside the step,
 modal damping per state on all FE modes) shares no code with ``impactbeam``.
 The comparison is made for the paper's reference Case 3 (gap 0.229 mm) and
 for zero gap (Case 9), on the Table 2 metrics max_response,
-first_impact_time and contact_duration (DESIGN.md section 3).
+first_impact_time and contact_duration (docs/metrics.md).
 
 How the tolerances are derived (each computed in the test from the runs):
 

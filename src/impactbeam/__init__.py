@@ -49,6 +49,7 @@ _EXPORTS: dict[str, str] = {
     "modes": "modal",
     "simulate": "simulation",
     "simulate_system": "simulation",
+    "convergence_study": "simulation",
     "SimulationResult": "result",
     "Event": "solver",
     "write_result": "result",
@@ -82,6 +83,8 @@ _EXPORTS: dict[str, str] = {
     "FatigueSpec": "model.fatigue",
     "random_response": "random",
     "RandomResponse": "random",
+    "validate": "validation",
+    "ValidationReport": "validation",
 }
 
 __all__ = [*_EXPORTS, "__version__"]
@@ -113,7 +116,8 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .modal import ModeSet, ScenarioModes, mode_set, modes, scenario_modes
     from .result import SimulationResult, write_result
     from .scenario import Scenario, load_scenario, parse_scenario
-    from .simulation import simulate, simulate_system
+    from .simulation import convergence_study, simulate, simulate_system
+    from .validation import ValidationReport, validate
     from .solver import Event
     from .experiment import Identification, identify
     from .periodic.shooting import PeriodicOrbit, periodic_orbit

@@ -25,6 +25,7 @@ from .model.beam import Beam, Contactor
 from .model.loading import Excitation
 from .model.starting import InitialCondition, Preload
 from .result import SimulationResult
+from .scenario.checks import check_response, check_run
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
 from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, estimate
 
@@ -105,9 +106,13 @@ def simulate_system(
     if excitation.kind == "point_force" and excitation.position is not None and excitation.position > beam.length * (1 + 1e-12):
         raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
     _check_distinct(contactors)
+    # what a scenario file is refused for, refused for objects too (a load whose response overflows, a run
+    # whose exact extrema would take out of proportion)
+    check_response(beam, excitation, initial, options.end_time)
+    check_run(beam, options.modes, options.end_time)
     if method not in ("exact", "ivp"):
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
-    _check_start(start, beam, contactors, options, method)
+    _check_start(start, beam, contactors, options, method, excitation)
 
     def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
         opt = options if options.modes == n_modes else dataclasses.replace(options, modes=n_modes)
@@ -132,7 +137,7 @@ def simulate_system(
 
 
 def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contactor, ...],
-                 options: SolverOptions, method: str) -> None:
+                 options: SolverOptions, method: str, excitation: Excitation) -> None:
     """ParameterError unless ``start`` is a state of this model's free-state basis."""
     if start is None:
         return
@@ -140,7 +145,7 @@ def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contact
         raise ParameterError(f"start: expected a ModalState (result.final_state()), got {type(start).__name__}")
     if method != "exact" or options.modes == "auto":
         raise ParameterError('start: a run from a modal state needs method = "exact" and a fixed solver.modes')
-    if start.basis != basis_signature(beam, contactors, int(options.modes), options.basis):
+    if start.basis != basis_signature(beam, contactors, int(options.modes), options.basis, excitation):
         raise ParameterError(
             "start: the state belongs to another modal basis (beam, contactor positions, solver.modes or "
             "solver.basis differ); start from rest or from a state of this model"

@@ -352,6 +352,11 @@ def count_below(beam: Beam, omega: float, springs: Sequence[tuple[float, float]]
     springs : sequence of (position, stiffness)
         Engaged contact springs, [m] and [N/m].
     """
+    omega = float(omega)
+    if not math.isfinite(omega):
+        raise ParameterError(f"omega: must be finite, got {omega!r}")
+    if omega <= 0.0:
+        return 0  # no frequency is negative (rigid-body modes are at zero, not below it)
     if beam.is_timoshenko:
         from . import timoshenko as _timoshenko
 

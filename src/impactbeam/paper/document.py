@@ -274,7 +274,7 @@ def _doc_figures(doc: _Doc, rep: ReproductionReport, data: dict[str, Any]) -> No
                       ("fig6_gap_size", "Fig. 6 analogue: response for gaps 0, 0.102, 0.229, 0.432 and 0.686 mm (Cases 9, 2, 3, 10, 11)"),
                       ("fig7_case12", "Fig. 7 analogue: Case 12 (no contactor) with the paper's peak values"),
                       ("fig8_case3", "Fig. 8 analogue: Case 3 with the paper's peak values"),
-                      ("case3_detail", "Case 3: deflection w from rest at the contact point, contact intervals, impacts, rebounds and contact force"),
+                      ("case3_detail", "Case 3: u = -w at the contact point (positive away from the contactor), contact intervals, impacts, rebounds and contact force"),
                       ("case0_free_decay", "Case 0: free decay after release from 2 mm at the tip")):
         doc.img(f"figures/{name}.png", alt)
 

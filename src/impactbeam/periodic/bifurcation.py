@@ -297,7 +297,8 @@ def _same_basis(state: Any, scenario: Scenario) -> bool:
     opt = scenario.solver
     if opt.modes == "auto":
         return False
-    return state.basis == basis_signature(scenario.beam, scenario.contactors, int(opt.modes), opt.basis)
+    return state.basis == basis_signature(scenario.beam, scenario.contactors, int(opt.modes), opt.basis,
+                                          scenario.excitation)
 
 
 def _unit(dimension: str) -> str:

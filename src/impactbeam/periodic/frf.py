@@ -101,7 +101,7 @@ def linear_steady_state(scenario: Scenario) -> ModalState:
     om, dec, pw = pk.om[0], pk.dec[0], pk.pw[0]
     Om = 2.0 * np.pi * float(ex.frequency)  # type: ignore[arg-type]
     q = pw * (ex.scale * ex.amplitude) / (om**2 - Om**2 + 2j * dec * Om) * np.exp(1j * ex.phase)
-    basis = basis_signature(scenario.beam, scenario.contactors, int(opt.modes), opt.basis)
+    basis = basis_signature(scenario.beam, scenario.contactors, int(opt.modes), opt.basis, ex)
     return ModalState(0.0, np.ascontiguousarray(q.imag), np.ascontiguousarray((1j * Om * q).imag), basis)
 
 

@@ -35,8 +35,9 @@ from .figure import PlotHandles, save_figure
 from .metrics import plot_metrics
 from .modes import plot_modes
 from .periodic import plot_bifurcation, plot_frequency_response, plot_map
+from .random import plot_impact_histogram, plot_input_psd, plot_rainflow_histogram, plot_random, plot_response_psd
 from .response import plot_excitation, plot_response, plot_result, surface_distance
-from .study import plot_convergence, plot_parameter_study
+from .study import plot_convergence, plot_convergence_study, plot_parameter_study
 from .style import SERIES_STYLES, STYLE, figure_size, rc_context
 from .sweep import plot_sweep, select_cases
 
@@ -47,12 +48,18 @@ __all__ = [
     "figure_size",
     "plot_bifurcation",
     "plot_convergence",
+    "plot_convergence_study",
     "plot_excitation",
     "plot_frequency_response",
+    "plot_impact_histogram",
+    "plot_input_psd",
     "plot_map",
     "plot_metrics",
     "plot_modes",
     "plot_parameter_study",
+    "plot_rainflow_histogram",
+    "plot_random",
+    "plot_response_psd",
     "plot_response",
     "plot_result",
     "plot_sweep",

@@ -1,6 +1,6 @@
 """What a simulation gives: the result object, its metrics, fields and files.
 
-* :class:`SimulationResult` and :func:`write_result` (:mod:`.simulation`):
+* :class:`SimulationResult` (:mod:`.simulation_result`) and :func:`write_result` (:mod:`.files`):
   the exact solution with lazy sampled grids, provenance and file writing;
 * :mod:`.metrics`: the response metrics from the exact solution;
 * :mod:`.stress`: bending moment and stress with the static correction;
@@ -12,6 +12,7 @@ This package reads the solver's exact solution; the figures are in
 
 from __future__ import annotations
 
-from .simulation_result import SimulationResult, write_result
+from .files import write_result
+from .simulation_result import SimulationResult
 
 __all__ = ["SimulationResult", "write_result"]

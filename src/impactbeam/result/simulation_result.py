@@ -11,7 +11,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._io import RESULT_SUFFIXES, atomic_path, write_netcdf
 from .._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
 from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
@@ -21,10 +20,7 @@ if TYPE_CHECKING:
 
     from ..solver.solution import Event, ModalState, PiecewiseSolution
 
-__all__ = [
-    "SimulationResult", "write_result", "RESULT_SUFFIXES", "sample_count", "memory_limit", "check_memory", "output_bytes",
-    "check_output_size", "STRESS_METRIC_UNITS",
-]
+__all__ = ["SimulationResult", "STRESS_METRIC_UNITS"]
 
 #: Units of the metrics that ``[output] fields = ["stress"]`` adds to :meth:`SimulationResult.metrics`.
 STRESS_METRIC_UNITS = {"max_bending_stress": "Pa", "max_bending_stress_time": "s", "max_bending_stress_position": "m"}
@@ -470,7 +466,8 @@ class SimulationResult:
 
         if not hasattr(self.solution, "modal_state"):
             raise ParameterError('final_state: only a run with method = "exact" has a modal state to continue from')
-        basis = basis_signature(self.beam, self.contactors, self.n_modes, self.options.get("basis", "enriched"))
+        basis = basis_signature(self.beam, self.contactors, self.n_modes, self.options.get("basis", "enriched"),
+                                self.solution.packed.space.excitation)
         return self.solution.modal_state(self.solution.t_end, basis)
 
     # ------------------------------------------------------------------ derived
@@ -592,46 +589,3 @@ def _one_dimensional(name: str, values: Any) -> np.ndarray:
     if arr.ndim != 1:
         raise ParameterError(f"{name}: expected a number or a 1-D sequence, got an array of shape {arr.shape}")
     return arr
-
-
-def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
-    """Write the full result to ``.nc`` (netCDF4/HDF5), ``.csv`` or ``.parquet``, atomically.
-
-    Parameters
-    ----------
-    result : SimulationResult
-    path : str or path-like
-        The file; its suffix chooses the format (:data:`RESULT_SUFFIXES`).
-
-    Returns
-    -------
-    Path
-
-    Raises
-    ------
-    ParameterError
-        An unsupported suffix.
-    ResourceError
-        The sampled histories would exceed the memory limit.
-    WriteError
-        The file could not be written (a read-only or full file system): nothing is left behind.
-    """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in RESULT_SUFFIXES:
-        raise ParameterError(f"--out: unsupported file type {suffix!r}; use one of {', '.join(RESULT_SUFFIXES)}")
-    from .._optional import require
-
-    require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    check_output_size(result.time.size, result.points.size, len(result.contactors), result.solution.n_modes)
-    if suffix == ".nc":
-        write_netcdf(result.to_xarray(), path)
-        return path
-    table = result.to_dataframe()
-    with atomic_path(path) as tmp:
-        if suffix == ".csv":
-            table.to_csv(tmp, index=False)
-        else:
-            table.to_parquet(tmp, index=False)
-    return path

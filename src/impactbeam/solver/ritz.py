@@ -80,13 +80,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..model.beam import Beam
+from ..model.beam import MERGE_DISTANCE, Beam
 from ..modal import ModeSet, mode_set, static_coefficients, static_state
 from .ritz_enrich import Enrichment, enrich
 
 __all__ = ["RitzBasis", "ritz_basis"]
 
-_MERGE = 3e-5  # contactors closer than this fraction of L share one attachment shape
 _DROP = 1e-11  # a residual shape smaller than this fraction of its static shape is dropped
 _LOSSY = 1e-12  # below this fraction the residual keeps fewer than ~4 digits (cancellation): warn
 _NEW = 1e-3  # an attachment direction below this fraction of the largest is dropped
@@ -131,7 +130,7 @@ class RitzBasis:
         L = beam.length
         pos: list[float] = []
         for a in sorted(float(p) for p in positions):
-            if not pos or a - pos[-1] > _MERGE * L:
+            if not pos or a - pos[-1] > MERGE_DISTANCE * L:  # closer contactors share one attachment shape
                 pos.append(a)
         self._alpha = np.array(pos) / L
         self._x, self._w = self._quadrature()

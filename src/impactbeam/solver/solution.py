@@ -66,20 +66,29 @@ class ModalState:
     basis: tuple
 
 
-def basis_signature(beam: Any, contactors: Any, modes: int, basis: str) -> tuple:
+def basis_signature(beam: Any, contactors: Any, modes: int, basis: str, excitation: Any = None) -> tuple:
     """What the free state's modal basis depends on (see :class:`ModalState`).
 
     Parameters
     ----------
     beam : Beam
     contactors : sequence of Contactor
-        Their positions enter the enriched basis (its attachment shapes).
+        Their positions and stiffnesses enter the enriched basis (its
+        attachment shapes, and the local shapes of a stiff stop).
     modes : int
         Retained modes per state.
     basis : {"enriched", "paper"}
+    excitation : Excitation, optional
+        A point force's position enters the enriched basis too (its second
+        load-dependent vector when it acts at a stop).
     """
-    positions = tuple(float(c.position) for c in contactors) if basis == "enriched" else ()
-    return (beam, positions, int(modes), basis)
+    if basis != "enriched":
+        return (beam, (), int(modes), basis)
+    stops = tuple((float(c.position), float(c.stiffness)) for c in contactors)
+    load = None
+    if excitation is not None and excitation.kind == "point_force" and excitation.position is not None:
+        load = float(excitation.position)
+    return (beam, stops, int(modes), basis, load)
 
 
 @dataclass(frozen=True, eq=False)

@@ -194,6 +194,8 @@ def impact_statistics(run: Any, window: tuple[float, float] | None = None) -> Im
     """
     steady = hasattr(run, "result") and hasattr(run, "window")
     result = run.result if steady else run
+    if not hasattr(result, "solution") or not hasattr(result, "contactors"):
+        raise TypeError(f"impact_statistics: expected a SteadyState or a SimulationResult, got {type(run).__name__}")
     lo, hi = analysis_window(result, run.window if steady and window is None else window)
     panel = 2.0 * math.pi / max(top_frequency(result), 1e-300)  # one period of the highest mode
     per, impacts = [], []
