@@ -191,6 +191,7 @@ def progress_bar(
     finally:
         if bar is not None:
             bar.close()
+            sys.stderr.flush()  # the bar's last line is out before any warning or error line
 
 
 class Interrupted(KeyboardInterrupt):
