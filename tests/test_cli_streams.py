@@ -74,3 +74,28 @@ def test_simulate_summary_on_stdout_warnings_on_stderr(warning_scenario):
     data = json.loads(proc.stdout)
     assert any("too stiff for this number of modes" in w for w in data["warnings"])
     assert not _warning_lines(proc.stderr)
+
+
+def test_progress_into_a_pipe_is_whole_lines_before_the_warnings():
+    # A bar redrawn with carriage returns ran into the first warning line of a CI log (the run took
+    # more than the 2 s before progress shows): into a pipe, progress is whole lines, and the
+    # warnings come after the last one, each on its own line.
+    code = (
+        "import time, warnings\n"
+        "from impactbeam.cli._group import handle_errors, progress_bar\n"
+        "from impactbeam.exceptions import ImpactBeamWarning\n"
+        "@handle_errors\n"
+        "def command():\n"
+        "    with progress_bar(1.0, desc='simulate', unit='s', after=0.0) as report:\n"
+        "        report(0.25); warnings.warn('too stiff', ImpactBeamWarning); time.sleep(0.05); report(1.0)\n"
+        "command()\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    err = proc.stderr.decode()
+    assert "\r" not in err
+    lines = err.splitlines()
+    assert lines[0].startswith("simulate:  25% (0.25/1 s)"), err
+    assert lines[-2].startswith("simulate: 100% (1/1 s)"), err
+    assert lines[-1] == "warning: too stiff", err
