@@ -1,0 +1,195 @@
+"""The solver's kernels: compiled by numba, or interpreted while the compiled ones are not yet cached.
+
+Numba compiles the kernels once per machine and keeps them in its disk cache.
+Compiling them takes 10-30 s of CPU, so on first use (an empty cache: a new
+environment, a new version) a run does not wait for it:
+
+* :func:`active` gives the compiled kernels when numba's cache holds them for
+  this machine (:func:`ready`), else their *interpreted twins*: the same
+  source executed by Python (:func:`interpreted`, the modules loaded a second
+  time with the decorator of :mod:`~impactbeam.solver._jit` replaced by the
+  identity), and starts one background process that compiles the kernels
+  into the cache (``python -m impactbeam.solver.warmup``);
+* both give the same results to the bit (the kernels use only IEEE
+  arithmetic in a fixed order and the C library's ``exp``, ``sin``, ``cos``,
+  ``sqrt``; integer powers are written out as numba computes them; a test
+  compares the two on every code path), so a run may switch from one to the
+  other at any checkpoint: the engine asks :func:`active` again whenever the
+  loop returns to Python, and a long first run moves to the compiled kernels
+  as soon as the background compile has finished;
+* :func:`compiled` gives the compiled kernels whatever the cache holds
+  (compiling them in this process if needed): the batched paths (sweeps,
+  bifurcation diagrams) ask for them, since they run long enough to pay for
+  the compile.
+
+``make install`` compiles the kernels once (``python -m impactbeam.solver.warmup``).
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import os
+import subprocess
+import sys
+import types
+from contextlib import contextmanager
+from collections.abc import Iterator
+
+__all__ = ["Kernels", "active", "compiled", "interpreted", "ready", "forced", "ENTRY_POINTS"]
+
+_LOG = logging.getLogger("impactbeam")
+_PACKAGE = __name__.rsplit(".", 1)[0]  # impactbeam.solver
+_TWIN = _PACKAGE + "._interpreted"
+_MODULES = ("_closed", "_events", "_loop", "_dense", "_metrics", "_batch")
+#: The kernels called from Python, (module, function): what the cache must hold for :func:`ready`.
+ENTRY_POINTS = (("_loop", "run"), ("_dense", "sample"), ("_dense", "extremum"), ("_dense", "integral"),
+                ("_metrics", "run_metrics"), ("_batch", "run_batch"))
+
+
+class Kernels(types.SimpleNamespace):
+    """The kernel modules' public names in one namespace (``K.run``, ``K.run_metrics``, ``K.DONE``, ...)."""
+
+    interpreted: bool
+
+
+def _namespace(prefix: str, interpreted_: bool) -> Kernels:
+    ns: dict[str, object] = {}
+    for name in _MODULES:
+        mod = importlib.import_module(f"{prefix}.{name}")
+        ns.update({k: v for k, v in vars(mod).items() if not k.startswith("__")})
+    return Kernels(**ns, interpreted=interpreted_)
+
+
+_COMPILED: Kernels | None = None
+_INTERPRETED: Kernels | None = None
+_READY = False
+_SPAWNED = False
+_FORCED: str | None = None
+
+
+def compiled() -> Kernels:
+    """The numba kernels (loaded from the cache, or compiled here on their first call)."""
+    global _COMPILED
+    if _COMPILED is None:
+        _COMPILED = _namespace(_PACKAGE, False)
+    return _COMPILED
+
+
+def interpreted() -> Kernels:
+    """The interpreted twins of the kernels (same source, run by Python; module docstring)."""
+    global _INTERPRETED
+    if _INTERPRETED is None:
+        if _TWIN not in sys.modules:
+            pkg = types.ModuleType(_TWIN, "interpreted twins of the solver's kernels")
+            pkg.__path__ = [os.path.dirname(__file__)]  # type: ignore[attr-defined]
+            jit = types.ModuleType(_TWIN + "._jit")
+            jit.njit = _identity  # type: ignore[attr-defined]
+            sys.modules[_TWIN] = pkg
+            sys.modules[_TWIN + "._jit"] = jit
+        _INTERPRETED = _namespace(_TWIN, True)
+    return _INTERPRETED
+
+
+def _identity(*args, **kwargs):  # the decorator of the twins: njit(f), njit(**options)(f) -> f
+    if args and callable(args[0]):
+        return args[0]
+    return lambda f: f
+
+
+def _cached(dispatcher) -> bool:
+    """Whether numba's disk cache holds a compiled version of ``dispatcher`` for this machine and source."""
+    try:
+        cache = dispatcher._cache
+        index = cache._cache_file._load_index()
+        want = cache._index_key(None, dispatcher.targetctx.codegen())[1:]
+    except AttributeError:  # the JIT is disabled (a plain function), or numba's internals changed
+        return True
+    return any(key[1:] == want for key in index)
+
+
+def ready() -> bool:
+    """Whether every kernel of :data:`ENTRY_POINTS` is in numba's cache for this machine (no compile needed)."""
+    global _READY
+    if not _READY:
+        compiled()  # imports the modules (numba compiles nothing before a first call)
+        _READY = all(_cached(getattr(sys.modules[f"{_PACKAGE}.{m}"], f)) for m, f in ENTRY_POINTS)
+    return _READY
+
+
+def active() -> Kernels:
+    """The kernels a run should use now: compiled when cached, else interpreted (module docstring)."""
+    if _FORCED == "interpreted":
+        return interpreted()
+    if _FORCED == "compiled" or _READY or ready():
+        return compiled()
+    _compile_in_background()
+    return interpreted()
+
+
+@contextmanager
+def forced(kind: str) -> Iterator[None]:
+    """Use the ``"compiled"`` or ``"interpreted"`` kernels within the block (tests, the warm-up).
+
+    Parameters
+    ----------
+    kind : {"compiled", "interpreted"}
+    """
+    global _FORCED
+    if kind not in ("compiled", "interpreted"):
+        raise ValueError(f"kind: 'compiled' or 'interpreted', got {kind!r}")
+    before, _FORCED = _FORCED, kind
+    try:
+        yield
+    finally:
+        _FORCED = before
+
+
+def lock_path() -> str:
+    """The warm-up's lock file, beside numba's cache of the kernels."""
+    try:
+        where = compiled().run._cache._cache_path
+    except AttributeError:
+        import tempfile
+
+        where = tempfile.gettempdir()
+    return os.path.join(where, "impactbeam-warmup.pid")
+
+
+def warmup_running() -> bool:
+    """Whether a warm-up process (``python -m impactbeam.solver.warmup``) is compiling the kernels now."""
+    try:
+        with open(lock_path()) as fh:
+            pid = int(fh.read().strip() or 0)
+    except (OSError, ValueError):
+        return False
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _compile_in_background() -> None:
+    """Start ``python -m impactbeam.solver.warmup`` once per process (unless one runs already), and say so."""
+    global _SPAWNED
+    if _SPAWNED:
+        return
+    _SPAWNED = True
+    running = warmup_running()
+    if not running:
+        try:
+            subprocess.Popen([sys.executable, "-m", f"{_PACKAGE}.warmup"], stdin=subprocess.DEVNULL,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                             close_fds=True)
+        except OSError as exc:  # no subprocess here: the run stays interpreted, correct and slower
+            _LOG.warning("impactbeam: cannot start the solver's compilation in the background (%s); "
+                         "runs use the interpreted solver", exc)
+            return
+    _LOG.warning("impactbeam: first use on this machine: the solver is being compiled in the background "
+                 "(about a minute); until then runs use its interpreted form (the same results, slower on long "
+                 "runs)")
