@@ -179,8 +179,9 @@ class _CaseBuilder:
     def cases(self, values: Sequence[Sequence[Any]]) -> list[Any]:
         """The cases of a batch (a Case each, or the exception its scenario raises)."""
         fresh = {(i, repr(v[i])) for v in values for i in self.direct} - self._known
-        # direct values all new (sampled designs): a parse per value would cost more than one per case
-        whole = len(fresh) > len(values)
+        # a parse per new value against one per case: a grid's values recur (and are kept for the next
+        # batches), a sampled design's are all new, several per case
+        whole = len(fresh) > 1.5 * len(values)
         return [self._whole(vals) if whole else self._direct(vals) or self._whole(vals) for vals in values]
 
     def _whole(self, vals: Sequence[Any]) -> Any:
