@@ -18,9 +18,11 @@ study over those reuses every mode and transfer matrix.
 
 from __future__ import annotations
 
+import contextlib
+import threading
 import weakref
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -29,7 +31,7 @@ from ..model.loading import Excitation, InitialCondition, time_pieces
 from ..modal import mode_set
 from . import _loop, kernels
 from ..model import Damping, SolverOptions
-from .solution import Event, Solution
+from .solution import Solution
 from .blocks import classical_slot, slot_arrays
 from .states import StateModel, StateSpace, _preload_key
 
@@ -279,6 +281,23 @@ class _Records:
                 setattr(self, name, _grow(getattr(self, name), n))
 
 
+_SPARE = threading.local()  # record arrays of this thread's last run, reused by its next one
+
+
+@contextlib.contextmanager
+def _records(nm: int) -> Iterator[_Records]:
+    """Record arrays for a run: this thread's spare ones (grown by earlier runs), or new ones when in use."""
+    rec = getattr(_SPARE, "rec", None)
+    if rec is None or rec.seg_eta.shape[1] != nm:
+        rec = _Records(nm)
+    else:
+        _SPARE.rec = None  # in use (a run started from a callback of this one gets its own)
+    try:
+        yield rec
+    finally:
+        _SPARE.rec = rec
+
+
 _PIECES: weakref.WeakKeyDictionary[Excitation, dict[float, tuple[np.ndarray, ...]]] = weakref.WeakKeyDictionary()
 
 
@@ -375,7 +394,12 @@ def integrate(
     # place of a scan stopped at a checkpoint
     carry = (eta, deta, eta.copy(), deta.copy(), np.zeros(nc1, dtype=np.int64), np.zeros(nc1, dtype=np.int64),
              np.zeros(3 * max(2 * len(contactors), 1)))
-    rec = _Records(nm)
+    with _records(nm) as rec:
+        return _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress)
+
+
+def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress) -> Solution:
+    """The loop of :func:`integrate` with the arrays it supplies; the solution copied out of ``rec``."""
     while True:
         ic[_loop.I_NSLOTS] = pk.nslots
         ic[_loop.I_NTR] = pk.ntr
@@ -400,11 +424,6 @@ def integrate(
 
 def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solution:
     nseg, nev, njump = int(ic[_loop.I_NSEG]), int(ic[_loop.I_NEV]), int(ic[_loop.I_NJUMP])
-    events = [
-        Event(t, "impact" if k else "rebound", c, v)
-        for t, k, c, v in zip(rec.ev_t[:nev].tolist(), rec.ev_kind[:nev].tolist(), rec.ev_c[:nev].tolist(),
-                              rec.ev_v[:nev].tolist())
-    ]
     t_stop = float(fc[_loop.F_T])
     code = 1 if status == _loop.CHATTER else 0
     message = stop_message(code, t_stop, nev)
@@ -416,11 +435,12 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solutio
     return Solution(
         t0=rec.seg_t0[:nseg].copy(), t1=rec.seg_t1[:nseg].copy(), slot=rec.seg_s[:nseg].copy(),
         piece=rec.seg_k[:nseg].copy(), eta0=rec.seg_eta[:nseg].copy(), deta0=rec.seg_deta[:nseg].copy(),
-        packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=events,
+        packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=None,
         energy_jumps=rec.jumps[:njump].copy(), event_penetrations=rec.ev_d[:nev].copy(), status=code,
         message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
-        n_modes=pk.n_modes, event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy()),
+        n_modes=pk.n_modes, event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy(),
+                                          rec.ev_v[:nev].copy()),
     )
 
 

@@ -275,7 +275,8 @@ class Solution(PiecewiseSolution):
     contactor_arrays : tuple of ndarray
         Positions, stiffnesses, gaps and sides of the contactors.
     contactors : tuple of Contactor
-    events : list of Event
+    events : list of Event or None
+        None: made from ``event_arrays`` when first asked for.
     energy_jumps : ndarray, [J]
         Change of mechanical energy at each switch.
     event_penetrations : ndarray, [m]
@@ -291,8 +292,8 @@ class Solution(PiecewiseSolution):
     n_modes : int
         Coordinates of the state bases.
     event_arrays : tuple of ndarray, optional
-        The events as arrays: times [s], kinds (1 impact, 0 rebound) and
-        contactors (default: from ``events``).
+        The events as arrays: times [s], kinds (1 impact, 0 rebound),
+        contactors and velocities [m/s] (default: from ``events``).
     """
 
     def __init__(self, *, t0, t1, slot, piece, eta0, deta0, packed, pieces, contactor_arrays, contactors,
@@ -308,7 +309,7 @@ class Solution(PiecewiseSolution):
         self.pieces = pieces
         self.contactor_arrays = contactor_arrays
         self.contactors = contactors
-        self.events = events
+        self._events = events
         self.energy_jumps = energy_jumps
         self.event_penetrations = event_penetrations
         self.status = status
@@ -320,11 +321,21 @@ class Solution(PiecewiseSolution):
         self.dashpots = packed.dash
         self._atol = 1e-12 * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
-        if event_arrays is None:  # times, kinds (1 impact, 0 rebound), contactors
+        if event_arrays is None:  # times, kinds (1 impact, 0 rebound), contactors, velocities
             event_arrays = (np.array([e.time for e in events], dtype=float),
                             np.array([e.kind == "impact" for e in events], dtype=np.int64),
-                            np.array([e.contactor for e in events], dtype=np.int64))
+                            np.array([e.contactor for e in events], dtype=np.int64),
+                            np.array([e.velocity for e in events], dtype=float))
         self.event_arrays = event_arrays
+
+    @property
+    def events(self) -> list[Event]:  # type: ignore[override]
+        """The events, made from :attr:`event_arrays` on first access."""
+        if self._events is None:
+            t, kind, c, v = self.event_arrays
+            self._events = [Event(ti, "impact" if ki else "rebound", ci, vi)
+                            for ti, ki, ci, vi in zip(t.tolist(), kind.tolist(), c.tolist(), v.tolist())]
+        return self._events
 
     @property
     def n_segments(self) -> int:
@@ -422,13 +433,13 @@ class Solution(PiecewiseSolution):
         """
         K = kernels.active()
         pk = self.packed
-        nev = len(self.events)
+        ev_t, ev_kind, ev_c = self.event_arrays[:3]
+        nev = ev_t.size
         n = nev + len(self.contactors) + 1
         rc = np.zeros(n, dtype=np.int64)
         rows = (rc, *(np.zeros(n) for _ in range(8)))
         out = np.empty(K.N_SCALARS)
         Wm, Wc = self.metric_rows(x)
-        ev_t, ev_kind, ev_c = self.event_arrays
         pcs = self.pieces
         n_rows = K.run_metrics(
             self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, ev_t, ev_kind, ev_c,

@@ -43,7 +43,7 @@ def warm_up() -> None:
         sol.sample(np.array([0.05, 0.1]), np.array([0.0, 0.01]), modal=True, energy=True)
         sol.extrema([(0.05, 0.0, 0.02, 1.0, 0.0, None)])
         sol.integrals([(0.05, 0.0, 0.02)])
-        ev_t, ev_kind, ev_c = sol.event_arrays
+        ev_t, ev_kind, ev_c = sol.event_arrays[:3]
         n = ev_t.size + 3
         rows = (np.zeros(n, dtype=np.int64), np.zeros(n), np.zeros(n), np.zeros(n))
         m = int(K.contact_rows(ev_t, ev_kind, ev_c, ev_t.size, 2, 0.03, *rows))
