@@ -193,11 +193,17 @@ def test_case_builder_gives_the_model_objects_of_a_reparse():
 
 
 def test_first_use_runs_interpreted_and_compiles_in_the_background(monkeypatch):
-    """With an empty cache a run does not wait for numba: interpreted kernels, one background compile."""
+    """With an empty cache a run does not wait for numba: interpreted kernels, one background compile.
+
+    And before the compiled kernels are loaded, small work runs interpreted without asking for them.
+    """
     started = []
     monkeypatch.setattr(kernels, "_READY", False)
+    monkeypatch.setattr(kernels, "_LOADED", False)
+    monkeypatch.setattr(kernels, "_CHECKED", -1e9)
     monkeypatch.setattr(kernels, "ready", lambda: False)
     monkeypatch.setattr(kernels, "_compile_in_background", lambda: started.append(1))
+    assert kernels.for_work(10).interpreted and started == []  # small: not even a look at the cache
     assert kernels.active().interpreted and started == [1]
     sc = _case3()
     res = ib.simulate(dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time=0.03)))

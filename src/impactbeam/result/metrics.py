@@ -162,7 +162,12 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     else:
         scalars, rows = _queried_arrays(result, x, sign, impacts)
     out = metrics_dict(scalars)
-    out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
+    arrays = getattr(sol, "event_arrays", None)
+    if arrays is not None:  # without making the Event tuples
+        out["events"] = [{"time": t, "kind": "impact" if k else "rebound", "contactor": c}
+                         for t, k, c in zip(arrays[0].tolist(), arrays[1].tolist(), arrays[2].tolist())]
+    else:
+        out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
     if impacts:
         out["impacts"] = _impact_table(result, rows) if np.isfinite(scalars[0]) else []
     return out
@@ -189,7 +194,7 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
     """:meth:`~impactbeam.solver.solution.Solution.metric_arrays` for any solution, through its queries."""
     from ..solver import kernels
 
-    K = kernels.active()
+    K = kernels.for_work(len(result.events))
     sol = result.solution
     t_end = sol.t_end
     con = result.contactors

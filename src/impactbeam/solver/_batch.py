@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._closed import copy_into
+from ._codes import CASE_DONE
 from ._dense import dense_work
 from ._jit import njit
 from ._loop import (
@@ -33,7 +34,6 @@ from ._metrics import run_metrics
 
 __all__ = ["run_batch", "start_case", "CASE_DONE", "B_CASE", "B_STARTED", "B_STOP_EACH", "B_STEPS", "N_BC"]
 
-CASE_DONE = 6  # a status beyond those of the loop
 B_CASE, B_STARTED, B_STOP_EACH, B_STEPS = 0, 1, 2, 3
 N_BC = 4
 

@@ -61,14 +61,12 @@ from ._jit import njit
 from ._closed import NP, alpha_at, copy_into, curvature_bound, particular, project, segment_setup, state_at, workspace
 from ._events import departure, scan
 
-DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
-# integer carry
-I_SLOT, I_PIECE, I_JUST, I_PENDING, I_NSEG, I_NEV, I_NJUMP, I_NSLOTS, I_NTR = 0, 1, 2, 3, 4, 5, 6, 7, 8
-I_WARN_C, REQ_A, REQ_B, I_RESUME, I_EVALS, I_SAME, I_WARN_N, I_USED = 9, 10, 11, 12, 13, 14, 15, 16
-N_INT = 17
-# float carry
-F_T, F_LAST_T, F_WARN_T, F_WARN_MOVED, F_WARN_SCALE, F_TAU = 0, 1, 2, 3, 4, 5
-N_FLOAT = 6
+from ._codes import (  # noqa: E402 - status codes and the carry's layout, shared with the Python side
+    CHATTER, CHECKPOINT, DONE, F_LAST_T, F_T, F_TAU, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T, I_EVALS, I_JUST, I_NEV,
+    I_NJUMP, I_NSEG, I_NSLOTS, I_NTR, I_PENDING, I_PIECE, I_RESUME, I_SAME, I_SLOT, I_USED, I_WARN_C, I_WARN_N,
+    N_FLOAT, N_INT, NEED_SPACE, NEED_STATE, NEED_TRANSFER, REQ_A, REQ_B,
+)
+
 KMAX = 5  # highest derivative used to judge a tangency
 ROW_MAIN, ROW_PHASE = 0, 1  # a contactor's switching row; the end of its released phase
 

@@ -24,7 +24,7 @@ import numpy as np
 from ..model import Damping, SolverOptions
 from ..model.beam import Beam, Contactor
 from ..model.loading import Excitation, InitialCondition
-from . import _loop, kernels
+from . import _codes as _loop, kernels
 from .engine import _BUDGET, _pieces, _Records, _solution, pack, projection_warning, space_initial_coordinates, stop_message
 from .solution import Solution
 
@@ -120,7 +120,7 @@ def integrate_batch(
     -------
     BatchResult
     """
-    K = kernels.compiled()
+    K = kernels.batched()
     n = len(excitations)
     contactors = tuple(contactor_sets[0])
     pk = pack(beam, contactors, damping, excitations[0], options[0], preload)
@@ -192,7 +192,7 @@ def integrate_batch(
             rec.grow(ic)
             if rows[0].size < rec.ev_t.size + nc + 1:
                 rows = table_rows()
-        elif st == K.CASE_DONE:
+        elif st == _loop.CASE_DONE:
             j = k - 1
             con = (gaps[j].copy(), sides[j].copy(), kst)
             sol = _solution(pk, tuple(contactor_sets[j]), options[j], pieces[j], con, fc, ic, rec,

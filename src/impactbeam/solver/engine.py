@@ -29,7 +29,7 @@ import numpy as np
 from ..model.beam import Beam, Contactor
 from ..model.loading import Excitation, InitialCondition, time_pieces
 from ..modal import mode_set
-from . import _loop, kernels
+from . import _codes as _loop, kernels
 from ..model import Damping, SolverOptions
 from .solution import Solution
 from .blocks import classical_slot, slot_arrays
@@ -37,7 +37,7 @@ from .states import StateModel, StateSpace, _preload_key
 
 __all__ = ["integrate", "initial_coordinates", "pack", "pack_key"]
 
-_BUDGET = 200_000  # scan steps between checkpoints (~20-50 ms compiled; a fiftieth of that interpreted)
+_BUDGET = 200_000  # scan steps between checkpoints (~20-50 ms compiled; 1,000 interpreted, ~0.1 s)
 _CACHE: OrderedDict[tuple, _Packed] = OrderedDict()
 _CACHE_SIZE = 64
 
@@ -321,7 +321,7 @@ def _call(K: kernels.Kernels, pk: _Packed, con: tuple[np.ndarray, ...], pcs: tup
             pk.reg, pk.dec, pk.wdh, pk.om, pk.omo, pk.Wc, pk.LW, pk.CW, pk.RW, pk.gen, pk.G, pk.H, pk.smask, pk.Tm,
             pk.tr_from, pk.tr_to, *con, pk.dash, *pcs,
             float(opt.end_time), tol_h, float(opt.event_tolerance), int(opt.max_events),
-            _BUDGET // 50 if K.interpreted else _BUDGET,
+            _BUDGET // 200 if K.interpreted else _BUDGET,
             fc, ic, *carry, rec.seg_t0, rec.seg_t1, rec.seg_s, rec.seg_k, rec.seg_eta, rec.seg_deta,
             rec.ev_t, rec.ev_kind, rec.ev_c, rec.ev_v, rec.ev_d, rec.jumps,
         ))
@@ -367,7 +367,7 @@ def integrate(
         The exact piecewise modal solution with its events.
     """
     contactors = tuple(contactors)
-    K = kernels.active()
+    K = kernels.for_work(0)  # interpreted until the run proves long, unless the compiled kernels are loaded
     pk = pack(beam, contactors, damping, excitation, options, preload)
     nm = pk.n_modes
     con = (
@@ -413,7 +413,7 @@ def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, p
         elif status == _loop.CHECKPOINT:
             if progress is not None:
                 progress(float(fc[_loop.F_T] + (fc[_loop.F_TAU] if ic[_loop.I_RESUME] else 0.0)))
-            if K.interpreted:  # the compiled kernels may have become ready meanwhile: same results, sooner
+            if K.interpreted:  # a long run: the compiled kernels (when cached) take over, the same results sooner
                 K = kernels.active()
         else:
             break

@@ -10,6 +10,10 @@ environment, a new version) a run does not wait for it:
   time with the decorator of :mod:`~impactbeam.solver._jit` replaced by the
   identity), and starts one background process that compiles the kernels
   into the cache (``python -m impactbeam.solver.warmup``);
+* :func:`for_work` runs small work interpreted until the compiled kernels
+  are loaded in the process: Case 3 (0.2 s, 26 segments) and its metrics
+  take ~0.04 s interpreted, less than importing numba and loading the
+  compiled code (~0.5 s), so a short run never loads them;
 * both give the same results to the bit (the kernels use only IEEE
   arithmetic in a fixed order and the C library's ``exp``, ``sin``, ``cos``,
   ``sqrt``; integer powers are written out as numba computes them; a test
@@ -32,11 +36,13 @@ import logging
 import os
 import subprocess
 import sys
+import time
 import types
 from contextlib import contextmanager
 from collections.abc import Iterator
 
-__all__ = ["Kernels", "active", "compiled", "interpreted", "ready", "forced", "ENTRY_POINTS"]
+__all__ = ["Kernels", "active", "for_work", "compiled", "interpreted", "ready", "forced", "batched", "ENTRY_POINTS",
+           "SMALL"]
 
 _LOG = logging.getLogger("impactbeam")
 _PACKAGE = __name__.rsplit(".", 1)[0]  # impactbeam.solver
@@ -64,6 +70,8 @@ def _namespace(prefix: str, interpreted_: bool) -> Kernels:
 _COMPILED: Kernels | None = None
 _INTERPRETED: Kernels | None = None
 _READY = False
+_LOADED = False  # the compiled kernels are in use in this process
+_CHECKED = -1e9  # when the cache was last looked at
 _SPAWNED = False
 _FORCED: str | None = None
 
@@ -118,13 +126,60 @@ def ready() -> bool:
 
 
 def active() -> Kernels:
-    """The kernels a run should use now: compiled when cached, else interpreted (module docstring)."""
+    """The compiled kernels when numba's cache holds them (loading them), else the interpreted ones.
+
+    In the second case one background process starts compiling them (module
+    docstring); the cache is looked at again at most once a second.
+    """
+    global _LOADED, _CHECKED
+    if _FORCED is not None:
+        return compiled() if _FORCED == "compiled" else interpreted()
+    if _LOADED:
+        return compiled()
+    now = time.monotonic()
+    if _READY or now - _CHECKED >= 1.0:
+        _CHECKED = now
+        if ready():
+            _LOADED = True
+            return compiled()
+        _compile_in_background()
+    return interpreted()
+
+
+def for_work(size: int) -> Kernels:
+    """The kernels for a piece of work of ``size`` (segments, samples or queries; see :data:`SMALL`).
+
+    The compiled ones once they are loaded in this process; before that a
+    small piece runs interpreted, which costs less than importing numba and
+    loading the compiled code (a few tenths of a second) would; a larger one
+    asks :func:`active`. A run (:func:`impactbeam.solver.engine.integrate`)
+    starts with ``size = 0`` and asks :func:`active` at its first checkpoint,
+    so a short run never loads the compiled kernels and a long one moves to
+    them (the same results, to the bit).
+    """
+    if _FORCED is not None or _LOADED or size > SMALL:
+        return active()
+    return interpreted()
+
+
+def batched() -> Kernels:
+    """The compiled kernels for a batch of cases, compiled here first if numba's cache lacks them.
+
+    A batch runs long enough to pay for the compile (and a sweep's workers
+    then find the cache warm).
+    """
+    global _LOADED
     if _FORCED == "interpreted":
         return interpreted()
-    if _FORCED == "compiled" or _READY or ready():
-        return compiled()
-    _compile_in_background()
-    return interpreted()
+    if not _LOADED and not ready():
+        _LOG.warning("impactbeam: compiling the solver for this machine (first use only; up to a minute on 2 cores)")
+    _LOADED = True
+    return compiled()
+
+
+#: Work done interpreted before the compiled kernels are loaded: a run's metrics up to this many segments and
+#: events, samples at up to this many times, extrema and integrals over up to this many segments in all.
+SMALL = 400
 
 
 @contextmanager

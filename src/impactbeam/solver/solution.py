@@ -10,6 +10,7 @@ use, which the ``solve_ivp`` reference path implements too.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -22,6 +23,17 @@ if TYPE_CHECKING:
     from ..model.beam import Contactor
 
 __all__ = ["Event", "Samples", "PiecewiseSolution", "Solution", "ModalState"]
+
+
+_WORK = threading.local()  # work arrays of the metrics, per thread, kernels and size
+
+
+def _work(K: Any, nm: int) -> tuple:
+    key = (id(K), nm)
+    hit = getattr(_WORK, "arrays", None)
+    if hit is None or hit[0] != key:
+        hit = _WORK.arrays = (key, K.dense_work(nm))
+    return hit[1]
 
 
 class Event(NamedTuple):
@@ -321,6 +333,7 @@ class Solution(PiecewiseSolution):
         self.dashpots = packed.dash
         self._atol = 1e-12 * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
+        self._metric_rows: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         if event_arrays is None:  # times, kinds (1 impact, 0 rebound), contactors, velocities
             event_arrays = (np.array([e.time for e in events], dtype=float),
                             np.array([e.kind == "impact" for e in events], dtype=np.int64),
@@ -395,7 +408,7 @@ class Solution(PiecewiseSolution):
         en = np.empty((nt, 5)) if energy else np.empty((0, 5))
         if nt and self.n_segments:
             pk = self.packed
-            kernels.active().sample(t, idx, self.rows(x), w, w_t, eta, eta_t, en, modal, energy,
+            kernels.for_work(nt).sample(t, idx, self.rows(x), w, w_t, eta, eta_t, en, modal, energy,
                           self.t0, self.slot, self.piece, self.eta0, self.deta0, pk.reg, pk.dec, pk.wdh, pk.om,
                           pk.omo, pk.Wc, pk.LW, pk.CW, pk.gen, pk.G, pk.Cd, pk.pw, pk.pre, pk.smask,
                           *self.contactor_arrays, pk.dash, self.pieces[0], *self.pieces[2:])
@@ -431,13 +444,12 @@ class Solution(PiecewiseSolution):
             over stiffness, ``int w dt`` and the compression at both ends
             (NaN without a dashpot), one entry per contact interval.
         """
-        K = kernels.active()
+        K = kernels.for_work(self.n_segments + self.event_arrays[0].size)
         pk = self.packed
         ev_t, ev_kind, ev_c = self.event_arrays[:3]
         nev = ev_t.size
         n = nev + len(self.contactors) + 1
-        rc = np.zeros(n, dtype=np.int64)
-        rows = (rc, *(np.zeros(n) for _ in range(8)))
+        rows = (np.zeros(n, dtype=np.int64), *np.zeros((8, n)))
         out = np.empty(K.N_SCALARS)
         Wm, Wc = self.metric_rows(x)
         pcs = self.pieces
@@ -445,7 +457,7 @@ class Solution(PiecewiseSolution):
             self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, ev_t, ev_kind, ev_c,
             self.event_penetrations, nev, self.energy_jumps, float(self.t_end), pk.reg, pk.dec, pk.wdh, pk.om, pk.LW,
             pk.CW, pk.gen, pk.G, pk.smask, *self.contactor_arrays, pk.dash, pcs[0], *pcs[2:], Wm, Wc, float(sign),
-            self._atol, 1e-14, bool(table), out, *rows, K.dense_work(self.n_modes),
+            self._atol, 1e-14, bool(table), out, *rows, _work(K, self.n_modes),
         )
         return out, tuple(r[:n_rows] for r in rows)
 
@@ -457,14 +469,15 @@ class Solution(PiecewiseSolution):
         x : float, [m]
             The metric point.
         """
-        Wm = self.rows(np.array([x], dtype=float))[:, 0, :]
-        nc = len(self.contactors)
-        Wc = np.empty((max(nc, 1),) + Wm.shape)
-        for c, con in enumerate(self.contactors):
-            Wc[c] = self.rows(np.array([con.position], dtype=float))[:, 0, :]
-        if not nc:
-            Wc[0] = 0.0
-        return np.ascontiguousarray(Wm), Wc
+        hit = self._metric_rows.get(x)
+        if hit is None:
+            Wm = self.rows(np.array([x], dtype=float))[:, 0, :]
+            nc = len(self.contactors)
+            Wc = np.zeros((max(nc, 1),) + Wm.shape)
+            for c, con in enumerate(self.contactors):
+                Wc[c] = self.rows(np.array([con.position], dtype=float))[:, 0, :]
+            hit = self._metric_rows[x] = (np.ascontiguousarray(Wm), Wc)
+        return hit
 
     def _row_table(self, xs: list[float]) -> tuple[np.ndarray, np.ndarray]:
         """Distinct positions of ``xs`` with their shapes in every visited state, and each x's row."""
@@ -483,7 +496,7 @@ class Solution(PiecewiseSolution):
             lo, hi, sign, offset, cond = (np.array(v) for v in zip(*(q[1:6] for q in queries)))
             cond = np.array([-1 if c is None else c for c in cond], dtype=np.int64)
             rate = np.array([q[6] if len(q) > 6 else 0.0 for q in queries], dtype=float)
-            kernels.active().extremum(
+            kernels.for_work(n * self.n_segments).extremum(
                 lo.astype(float), np.minimum(hi.astype(float), self.t_end), sign.astype(float),
                 offset.astype(float), rate, row, cond, self._atol, 1e-14, Wr, out[0], out[1],
                 self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, *self._model(),
@@ -502,7 +515,7 @@ class Solution(PiecewiseSolution):
             Wr, row = self._row_table([q[0] for q in queries])
             lo = np.array([q[1] for q in queries], dtype=float)
             hi = np.minimum(np.array([q[2] for q in queries], dtype=float), self.t_end)
-            kernels.active().integral(lo, hi, row, Wr, out, self.t0, self.t1, self.slot, self.piece, self.eta0,
+            kernels.for_work(n * self.n_segments).integral(lo, hi, row, Wr, out, self.t0, self.t1, self.slot, self.piece, self.eta0,
                             self.deta0, *self._model())
         return out
 
