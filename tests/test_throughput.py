@@ -201,6 +201,7 @@ def test_first_use_runs_interpreted_and_compiles_in_the_background(monkeypatch):
     monkeypatch.setattr(kernels, "_READY", False)
     monkeypatch.setattr(kernels, "_LOADED", False)
     monkeypatch.setattr(kernels, "_CHECKED", -1e9)
+    monkeypatch.setattr(kernels, "_SPENT", 0.0)
     monkeypatch.setattr(kernels, "ready", lambda: False)
     monkeypatch.setattr(kernels, "_compile_in_background", lambda: started.append(1))
     assert kernels.for_work(10).interpreted and started == []  # small: not even a look at the cache

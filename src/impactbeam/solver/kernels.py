@@ -72,6 +72,7 @@ _INTERPRETED: Kernels | None = None
 _READY = False
 _LOADED = False  # the compiled kernels are in use in this process
 _CHECKED = -1e9  # when the cache was last looked at
+_SPENT = 0.0  # seconds spent in the interpreted kernels' entry points
 _SPAWNED = False
 _FORCED: str | None = None
 
@@ -85,7 +86,12 @@ def compiled() -> Kernels:
 
 
 def interpreted() -> Kernels:
-    """The interpreted twins of the kernels (same source, run by Python; module docstring)."""
+    """The interpreted twins of the kernels (same source, run by Python; module docstring).
+
+    Their entry points (:data:`ENTRY_POINTS`) add the time they take to
+    :data:`_SPENT`, from which :func:`for_work` judges when a process has run
+    enough small work to be better off with the compiled kernels.
+    """
     global _INTERPRETED
     if _INTERPRETED is None:
         if _TWIN not in sys.modules:
@@ -95,8 +101,24 @@ def interpreted() -> Kernels:
             jit.njit = _identity  # type: ignore[attr-defined]
             sys.modules[_TWIN] = pkg
             sys.modules[_TWIN + "._jit"] = jit
-        _INTERPRETED = _namespace(_TWIN, True)
+        ns = _namespace(_TWIN, True)
+        for _, name in ENTRY_POINTS:
+            setattr(ns, name, _timed(getattr(ns, name)))
+        _INTERPRETED = ns
     return _INTERPRETED
+
+
+def _timed(fn):
+    def call(*args):
+        global _SPENT
+        t0 = time.perf_counter()
+        try:
+            return fn(*args)
+        finally:
+            _SPENT += time.perf_counter() - t0
+    call.__wrapped__ = fn  # type: ignore[attr-defined]
+    call.__doc__ = fn.__doc__
+    return call
 
 
 def _identity(*args, **kwargs):  # the decorator of the twins: njit(f), njit(**options)(f) -> f
@@ -151,13 +173,14 @@ def for_work(size: int) -> Kernels:
 
     The compiled ones once they are loaded in this process; before that a
     small piece runs interpreted, which costs less than importing numba and
-    loading the compiled code (a few tenths of a second) would; a larger one
-    asks :func:`active`. A run (:func:`impactbeam.solver.engine.integrate`)
+    loading the compiled code (a few tenths of a second) would; a larger one,
+    or any once the process has spent :data:`SPENT_LIMIT` seconds in
+    interpreted kernels (a loop of short runs), asks :func:`active`. A run (:func:`impactbeam.solver.engine.integrate`)
     starts with ``size = 0`` and asks :func:`active` at its first checkpoint,
     so a short run never loads the compiled kernels and a long one moves to
     them (the same results, to the bit).
     """
-    if _FORCED is not None or _LOADED or size > SMALL:
+    if _FORCED is not None or _LOADED or size > SMALL or _SPENT > SPENT_LIMIT:
         return active()
     return interpreted()
 
@@ -176,6 +199,9 @@ def batched() -> Kernels:
     _LOADED = True
     return compiled()
 
+
+#: Seconds of interpreted kernels after which a process asks for the compiled ones (a loop of short runs).
+SPENT_LIMIT = 0.3
 
 #: Work done interpreted before the compiled kernels are loaded: a run's metrics up to this many segments and
 #: events, samples at up to this many times, extrema and integrals over up to this many segments in all.
