@@ -51,6 +51,9 @@ def main() -> None:
     args = ap.parse_args()
     warnings.simplefilter("ignore", ib.ImpactBeamWarning)  # counted below instead
     sc = scenario()
+    from impactbeam.solver import kernels
+
+    kernels.active()  # the compiled kernels from the start
     freqs = np.linspace(30.0, 130.0, args.points)
     ib.frequency_response(sc, freqs[:2], settle_periods=2, record_periods=2)  # compile / warm caches
 

@@ -140,8 +140,8 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     rules (:mod:`impactbeam.solver._metrics`). The minimum of ``u`` in a
     contact interval of the first contactor is read from that interval's
     peak compression (``u = -s w(a)`` there, so ``min u = -(peak
-    compression + gap)``), and ``max_penetration`` is the largest of those
-    peaks.
+    compression + gap)``), and ``max_penetration`` is the largest compression
+    of the first contactor over the run.
 
     Parameters
     ----------
@@ -210,15 +210,20 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
     queries: list[tuple] = [(x, 0.0, t_end, sign, 0.0, None)]
     if not nc:
         queries.append((x, 0.0, t_end, -sign, 0.0, None))
-    queries += [_peak_query(result, int(c), a, be) for c, a, be in zip(rc, ra, rbe)]
+    else:  # the largest compression of the first contactor over the run
+        c0 = con[0]
+        queries.append((c0.position, 0.0, t_end, c0.direction, -c0.direction * c0.gap, 0))
     ext = sol.extrema(queries)
     top, t_top = float(ext[0, 0]), float(ext[0, 1])
-    peaks = ext[len(queries) - n_rows:, 0].copy()
+    peaks = np.full(n_rows, np.nan)
     contact = np.full(5, np.nan)
     peak_after = np.nan
     if nc:
         K.first_contact(ev_t, ev_kind, ev_c, nev, t_top, contact)
         a, b = contact[3], contact[4]
+        want = [i for i in range(n_rows) if table or (rc[i] == 0 and ra[i] == a)]
+        if want:
+            peaks[want] = sol.extrema([_peak_query(result, int(rc[i]), ra[i], rbe[i]) for i in want])[:, 0]
         if np.isfinite(top) and np.isfinite(a) and a < t_end and not np.any((rc == 0) & (ra == a)):
             peak_after = float(sol.extrema([_peak_query(result, 0, a, min(b, t_end))])[0, 0])
     energy = 0.0
@@ -230,8 +235,9 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
         energy = (-K.pairwise_sum(jumps, jumps.size)
                   - K.release_loss_sum(ev_c, ev_kind, pen, nev, dash, kst, np.empty(max(nev, 1))))
     out = np.empty(K.N_SCALARS)
-    K.assemble(out, nev, top, t_top, float(ext[1, 0]) if not nc else np.nan, energy, n_rows, rc, ra, peaks,
-               contact, con[0].gap if nc else 0.0, peak_after)
+    low, deepest = (float(ext[1, 0]), np.nan) if not nc else (np.nan, float(ext[1, 0]))
+    K.assemble(out, nev, top, t_top, low, energy, deepest, n_rows, rc, ra, peaks, contact, con[0].gap if nc else 0.0,
+               peak_after)
     fpeaks, ints, d0, d1 = peaks.copy(), np.zeros(n_rows), np.full(n_rows, np.nan), np.full(n_rows, np.nan)
     if table and n_rows:
         dash = getattr(sol, "dashpots", np.zeros(nc))

@@ -9,17 +9,19 @@ alone or in a batch:
 * :func:`contact_rows`: every contact interval of every contactor whose
   clipped length ``min(end, t_end) - start`` is positive, contactor by
   contactor in time order (the per-impact table's rows);
-* :func:`assemble`: the scalar metrics from the extremum of ``u``, the peak
-  compression of each row, the contact intervals of the first contactor and
-  the energy jumps;
+* :func:`assemble`: the scalar metrics from the extremum of ``u``, the
+  largest compression of the first contactor over the run, the peak
+  compression of the first contact after the maximum, the contact intervals
+  of the first contactor and the energy jumps;
 * :func:`run_metrics`: both, with the extrema and integrals in closed form
   (:mod:`~impactbeam.solver._dense`); with ``table`` also each row's peak
   force, impulse integral and end penetrations.
 
-The extrema are the same queries, in the same order, as the per-impact
-table's; a solution that is not the exact one (the ``solve_ivp`` reference)
-uses :func:`contact_rows` and :func:`assemble` around its own extrema
-(:func:`impactbeam.result.metrics.compute_metrics`).
+The scalar metrics do not depend on whether the table is computed (the peak
+``min_response`` reads is the same query as that row's in the table); a
+solution that is not the exact one (the ``solve_ivp`` reference) uses
+:func:`contact_rows`, :func:`first_contact` and :func:`assemble` around its
+own extrema (:func:`impactbeam.result.metrics.compute_metrics`).
 """
 
 from __future__ import annotations
@@ -172,16 +174,18 @@ def first_contact(ev_t, ev_kind, ev_c, nev, t_max, out):  # pragma: no cover - c
 
 
 @njit(cache=True, nogil=True)
-def assemble(out, nev, top, t_top, low, energy_residual, n_rows, rc, ra, peaks, contact, gap0, peak_after):
+def assemble(out, nev, top, t_top, low, energy_residual, deepest, n_rows, rc, ra, peaks, contact, gap0, peak_after):
     # pragma: no cover - compiled
     """The scalar metrics (order :data:`SCALARS`, NaN for undefined) from what the queries found.
 
     ``top, t_top``: the maximum of ``u`` and its time; ``low``: the maximum
-    of ``-u`` (no contactor, else unused); ``peaks[i]``: the peak compression
-    of row ``i``; ``contact``: :func:`first_contact` at ``t_top``;
-    ``peak_after``: the peak compression over the first contact interval
-    after ``t_top`` when it is not one of the rows (NaN otherwise, or when
-    there is none). No contactor: ``rc`` is empty and ``gap0`` unused.
+    of ``-u`` (no contactor, else unused); ``deepest``: the largest
+    compression of the first contactor over the run (while engaged);
+    ``peaks[i]``: the peak compression of row ``i`` (NaN where not computed);
+    ``contact``: :func:`first_contact` at ``t_top``; ``peak_after``: the peak
+    compression over the first contact interval after ``t_top`` when no row
+    holds it (NaN otherwise, or when there is none). No contactor: ``rc`` is
+    empty and ``gap0`` unused.
     """
     for i in range(out.size):
         out[i] = np.nan
@@ -194,10 +198,6 @@ def assemble(out, nev, top, t_top, low, energy_residual, n_rows, rc, ra, peaks, 
     if np.isnan(contact[0]):
         out[MIN_RESPONSE] = -low
         return
-    deepest = -np.inf
-    for i in range(n_rows):
-        if rc[i] == 0 and peaks[i] > deepest:
-            deepest = peaks[i]
     out[MAX_PENETRATION] = max(deepest, 0.0) if math.isfinite(deepest) else 0.0
     out[N_IMPACTS] = contact[0]
     out[FIRST_IMPACT] = contact[1]
@@ -210,7 +210,7 @@ def assemble(out, nev, top, t_top, low, energy_residual, n_rows, rc, ra, peaks, 
         out[CONTACT_DURATION] = b - a
     peak = peak_after
     for i in range(n_rows):
-        if rc[i] == 0 and ra[i] == a:
+        if rc[i] == 0 and ra[i] == a and not np.isnan(peaks[i]):
             peak = peaks[i]
             break
     if math.isfinite(peak):
@@ -240,6 +240,7 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
                                 seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0,
                                 pconst, pslope, pamp, pOm, pphase, work)
     low = np.nan
+    deepest = np.nan
     contact = np.full(5, np.nan)
     n_rows = 0
     peak_after = np.nan
@@ -249,13 +250,23 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
                                 pconst, pslope, pamp, pOm, pphase, work)
     if nc > 0:
         n_rows = contact_rows(ev_t, ev_kind, ev_c, nev, nc, t_end, rc, ra, rb, rbe)
-        for i in range(n_rows):
-            c = rc[i]
-            peaks[i], _ = extremum_query(ra[i], rbe[i], side[c], -side[c] * gap[c], 0.0, Wc[c], c, atol, xtol, seg_t0,
-                                         seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G,
-                                         smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, work)
         first_contact(ev_t, ev_kind, ev_c, nev, t_top, contact)
         a = contact[3]
+        for i in range(n_rows):  # the table's peaks; without it only the one min_response reads
+            c = rc[i]
+            peaks[i] = np.nan
+            if table or (c == 0 and ra[i] == a):
+                peaks[i], _ = extremum_query(ra[i], rbe[i], side[c], -side[c] * gap[c], 0.0, Wc[c], c, atol, xtol,
+                                             seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW,
+                                             gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
+                                             work)
+        if math.isfinite(top):
+            # the largest compression over the run: one search over the engaged segments (the best value so far
+            # prunes the later, shallower contacts), not the largest of the peaks, so it is the same with or
+            # without the table
+            deepest, _ = extremum_query(0.0, t_end, side[0], -side[0] * gap[0], 0.0, Wc[0], 0, atol, xtol, seg_t0,
+                                        seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G,
+                                        smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, work)
         if math.isfinite(top) and not np.isnan(a) and a < t_end:
             known = False
             for i in range(n_rows):
@@ -270,7 +281,8 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
     if math.isfinite(top):
         scratch = np.empty(max(nev, 1))
         energy = -pairwise_sum(jumps, jumps.size) - release_loss_sum(ev_c, ev_kind, ev_d, nev, dash, kst, scratch)
-    assemble(out, nev, top, t_top, low, energy, n_rows, rc, ra, peaks, contact, gap[0] if nc else 0.0, peak_after)
+    assemble(out, nev, top, t_top, low, energy, deepest, n_rows, rc, ra, peaks, contact, gap[0] if nc else 0.0,
+             peak_after)
     if table:
         for i in range(n_rows):
             c = rc[i]

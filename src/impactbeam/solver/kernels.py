@@ -78,11 +78,87 @@ _FORCED: str | None = None
 
 
 def compiled() -> Kernels:
-    """The numba kernels (loaded from the cache, or compiled here on their first call)."""
+    """The numba kernels (loaded from the cache, or compiled here on their first call).
+
+    Numba keys a cached kernel on its own source only, not on the functions
+    it calls: after a kernel module changed, a caller's cache entry would
+    still load, with the old callee inside. So the cache counts as this
+    code's only when the digest of every kernel module (written by the
+    warm-up once it has compiled them all) matches; when it does not (and no
+    warm-up is running), the kernels' cache files are removed before any is
+    loaded, and numba compiles them afresh.
+    """
     global _COMPILED
     if _COMPILED is None:
-        _COMPILED = _namespace(_PACKAGE, False)
+        ns = _namespace(_PACKAGE, False)
+        if not _digest_matches(ns) and not warmup_running(ns):
+            purge_cache(ns)
+        _COMPILED = ns
     return _COMPILED
+
+
+def source_digest() -> str:
+    """SHA-256 of the kernel modules' sources and numba's version (what the compiled kernels are made of)."""
+    import hashlib
+
+    import numba
+
+    h = hashlib.sha256(numba.__version__.encode())
+    here = os.path.dirname(__file__)
+    for name in (*_MODULES, "_codes", "_jit"):
+        with open(os.path.join(here, name + ".py"), "rb") as fh:
+            h.update(fh.read())
+    return h.hexdigest()
+
+
+def _cache_dir(ns: Kernels) -> str | None:
+    try:
+        return ns.run._cache._cache_path
+    except AttributeError:  # the JIT is disabled
+        return None
+
+
+def _digest_path(ns: Kernels) -> str | None:
+    where = _cache_dir(ns)
+    return None if where is None else os.path.join(where, "impactbeam-kernels.digest")
+
+
+def _digest_matches(ns: Kernels) -> bool:
+    path = _digest_path(ns)
+    if path is None:
+        return True
+    try:
+        with open(path) as fh:
+            return fh.read().strip() == source_digest()
+    except OSError:
+        return False
+
+
+def write_digest() -> None:
+    """Record that the cache holds every kernel compiled from the present sources (the warm-up's last step)."""
+    path = _digest_path(compiled())
+    if path is not None:
+        try:
+            with open(path + ".tmp", "w") as fh:
+                fh.write(source_digest())
+            os.replace(path + ".tmp", path)
+        except OSError:  # a read-only cache: numba does not write there either
+            pass
+
+
+def purge_cache(ns: Kernels | None = None) -> None:
+    """Remove the kernels' files from numba's cache (before any is loaded), so that they are compiled afresh."""
+    import glob
+
+    where = _cache_dir(ns or compiled())
+    if where is None:
+        return
+    for name in _MODULES:
+        for f in glob.glob(os.path.join(where, f"{name}.*.nb[ic]")):
+            try:
+                os.unlink(f)
+            except OSError:
+                pass
 
 
 def interpreted() -> Kernels:
@@ -139,11 +215,12 @@ def _cached(dispatcher) -> bool:
 
 
 def ready() -> bool:
-    """Whether every kernel of :data:`ENTRY_POINTS` is in numba's cache for this machine (no compile needed)."""
+    """Whether numba's cache holds every kernel of :data:`ENTRY_POINTS`, compiled for this machine from these sources."""
     global _READY
     if not _READY:
-        compiled()  # imports the modules (numba compiles nothing before a first call)
-        _READY = all(_cached(getattr(sys.modules[f"{_PACKAGE}.{m}"], f)) for m, f in ENTRY_POINTS)
+        ns = compiled()  # imports the modules (numba compiles nothing before a first call)
+        _READY = _digest_matches(ns) and all(
+            _cached(getattr(sys.modules[f"{_PACKAGE}.{m}"], f)) for m, f in ENTRY_POINTS)
     return _READY
 
 
@@ -194,7 +271,7 @@ def batched() -> Kernels:
     global _LOADED
     if _FORCED == "interpreted":
         return interpreted()
-    if not _LOADED and not ready():
+    if _FORCED is None and not _LOADED and not ready():
         _LOG.warning("impactbeam: compiling the solver for this machine (first use only; up to a minute on 2 cores)")
     _LOADED = True
     return compiled()
@@ -226,21 +303,32 @@ def forced(kind: str) -> Iterator[None]:
         _FORCED = before
 
 
-def lock_path() -> str:
-    """The warm-up's lock file, beside numba's cache of the kernels."""
-    try:
-        where = compiled().run._cache._cache_path
-    except AttributeError:
+def lock_path(ns: Kernels | None = None) -> str:
+    """The warm-up's lock file, beside numba's cache of the kernels.
+
+    Parameters
+    ----------
+    ns : Kernels, optional
+        The compiled kernels' namespace (default :func:`compiled`).
+    """
+    where = _cache_dir(ns or compiled())
+    if where is None:
         import tempfile
 
         where = tempfile.gettempdir()
     return os.path.join(where, "impactbeam-warmup.pid")
 
 
-def warmup_running() -> bool:
-    """Whether a warm-up process (``python -m impactbeam.solver.warmup``) is compiling the kernels now."""
+def warmup_running(ns: Kernels | None = None) -> bool:
+    """Whether a warm-up process (``python -m impactbeam.solver.warmup``) is compiling the kernels now.
+
+    Parameters
+    ----------
+    ns : Kernels, optional
+        The compiled kernels' namespace (default :func:`compiled`).
+    """
     try:
-        with open(lock_path()) as fh:
+        with open(lock_path(ns)) as fh:
             pid = int(fh.read().strip() or 0)
     except (OSError, ValueError):
         return False
