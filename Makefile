@@ -12,6 +12,8 @@ $(BIN)/python:
 $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[all,test,docs]"
+	@# compile the solver's kernels into numba's cache once, so no later run waits for them
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python -m impactbeam.solver.warmup
 	touch $(STAMP)
 
 install: $(STAMP)

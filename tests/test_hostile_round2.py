@@ -585,7 +585,8 @@ def test_ctrl_c_stops_the_timoshenko_mode_search(tmp_path: Path) -> None:
 def test_ctrl_c_inside_the_exact_extrema_at_the_work_limit(tmp_path: Path) -> None:
     # Reason: the metrics' extrema are one compiled call that a signal interrupts only when it returns;
     # at the work limit (Case 3, 8 modes, the undamped run of test_interrupts with impacts) the wait must
-    # stay below 5 s (measured ~1.8 s; at twice the limit 3.6 s, at five times 4.4 to 6.6 s).
+    # stay below 5 s (measured ~1.8 s before the compiled metrics pruned later contacts; now they often end
+    # before the signal).
     from impactbeam._memory import work_limit
     from impactbeam.model.magnitudes import scan_work
 
@@ -600,7 +601,7 @@ def test_ctrl_c_inside_the_exact_extrema_at_the_work_limit(tmp_path: Path) -> No
         "     'solver.time_step': 1.0})\n"
         "res = ib.simulate(sc)\n"
         "sent = []\n"
-        "threading.Timer(0.3, lambda: (sent.append(time.monotonic()), os.kill(os.getpid(), signal.SIGINT))).start()\n"
+        "threading.Timer(0.02, lambda: (sent.append(time.monotonic()), os.kill(os.getpid(), signal.SIGINT))).start()\n"
         "try:\n"
         "    res.metrics(impacts=False)\n"
         "    print('finished', time.monotonic() - sent[0] if sent else None)\n"
@@ -610,7 +611,9 @@ def test_ctrl_c_inside_the_exact_extrema_at_the_work_limit(tmp_path: Path) -> No
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     word, wait = out.stdout.split()
     assert word in ("interrupted", "finished"), out.stderr
-    assert float(wait) < 5.0
+    # "finished None": the metrics ended before the signal (they take ~0.02-0.1 s since the compiled pass
+    # prunes the later, shallower contacts), so no wait at all
+    assert wait == "None" or float(wait) < 5.0
 
 
 @pytest.mark.faults

@@ -14,6 +14,7 @@ import dataclasses
 import functools
 import os
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -32,7 +33,7 @@ from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, e
 if TYPE_CHECKING:
     from .scenario import Scenario
 
-__all__ = ["convergence_study", "simulate", "simulate_system"]
+__all__ = ["Case", "CaseMetrics", "convergence_study", "run_cases", "simulate", "simulate_system"]
 
 Method = Literal["exact", "ivp"]
 
@@ -85,6 +86,34 @@ def simulate_system(
     initial = initial or InitialCondition()
     options = options or SolverOptions()
     contactors = tuple(contactors)
+    pts_arr = _check_system(beam, contactors, excitation, initial, options, points, method)
+    _check_start(start, beam, contactors, options, method, excitation)
+
+    def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
+        opt = options if options.modes == n_modes else dataclasses.replace(options, modes=n_modes)
+        if method == "ivp":
+            from .solver.reference import integrate_ivp
+
+            solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt, preload)
+        else:
+            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress,
+                                 None if start is None else (start.eta, start.deta), preload)
+        if announce:
+            for text in solution.warnings:
+                warn(text)
+        info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method,
+                "basis": opt.basis}
+        return SimulationResult(solution, pts_arr, beam, contactors, n_modes, opt.time_step, opt.end_time, name,
+                                info, rerun=functools.partial(run, announce=False), tolerance=opt.tolerance)
+
+    if options.modes != "auto":
+        return run(int(options.modes))
+    return _auto_modes(run, options.tolerance)
+
+
+def _check_system(beam: Beam, contactors: tuple[Contactor, ...], excitation: Excitation, initial: InitialCondition,
+                  options: SolverOptions, points: Sequence[float] | None, method: str) -> np.ndarray:
+    """ParameterError for what the solver cannot represent or would not finish; the output points as an array."""
     for i, c in enumerate(contactors):
         c.check_on(beam, f"contactors.{i}")
         if np.isinf(c.stiffness):
@@ -112,28 +141,7 @@ def simulate_system(
     check_run(beam, options.modes, options.end_time)
     if method not in ("exact", "ivp"):
         raise ParameterError(f"method: must be 'exact' or 'ivp', got {method!r}")
-    _check_start(start, beam, contactors, options, method, excitation)
-
-    def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
-        opt = options if options.modes == n_modes else dataclasses.replace(options, modes=n_modes)
-        if method == "ivp":
-            from .solver.reference import integrate_ivp
-
-            solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt, preload)
-        else:
-            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress,
-                                 None if start is None else (start.eta, start.deta), preload)
-        if announce:
-            for text in solution.warnings:
-                warn(text)
-        info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method,
-                "basis": opt.basis}
-        return SimulationResult(solution, pts_arr, beam, contactors, n_modes, opt.time_step, opt.end_time, name,
-                                info, rerun=functools.partial(run, announce=False), tolerance=opt.tolerance)
-
-    if options.modes != "auto":
-        return run(int(options.modes))
-    return _auto_modes(run, options.tolerance)
+    return pts_arr
 
 
 def _check_start(start: ModalState | None, beam: Beam, contactors: tuple[Contactor, ...],
@@ -351,3 +359,137 @@ def simulate(
     )
     object.__setattr__(res, "scenario", scenario)
     return res
+
+
+@dataclass(frozen=True, eq=False)
+class Case:
+    """One run given as model objects (what a scenario holds), for :func:`run_cases`.
+
+    Attributes
+    ----------
+    beam : Beam
+    contactors : tuple of Contactor
+    damping : Damping
+    excitation : Excitation
+    initial : InitialCondition
+    options : SolverOptions
+    points : tuple of float or None, [m]
+        Output points (default: the contactors, then the right end).
+    preload : Preload or None
+        The constant load of ``[preload]``.
+    """
+
+    beam: Beam
+    contactors: tuple[Contactor, ...]
+    damping: Damping
+    excitation: Excitation
+    initial: InitialCondition
+    options: SolverOptions
+    points: tuple[float, ...] | None = None
+    preload: Preload | None = None
+
+
+@dataclass
+class CaseMetrics:
+    """The metrics of :func:`run_cases`, one entry per case.
+
+    Attributes
+    ----------
+    scalars : ndarray, (n_cases, 10)
+        The keys of :data:`impactbeam.result.metrics.METRIC_UNITS` in order, NaN where undefined or failed.
+    status : ndarray of int, (n_cases,)
+        0 end time reached, 1 stopped by the chattering guard, -1 failed.
+    messages : list of str
+        The solver's message, or the error of a failed case.
+    errors : list of Exception or None
+        The exception of each failed case.
+    """
+
+    scalars: np.ndarray
+    status: np.ndarray
+    messages: list[str]
+    errors: list[BaseException | None] = field(default_factory=list)
+
+
+def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None = None) -> CaseMetrics:
+    """The metrics of many runs, the cases of each packed problem in one compiled batch.
+
+    Each case gives exactly what ``simulate_system(...).metrics(impacts=False)``
+    gives (the same checks, the same compiled loop and metrics): cases that
+    share their packed problem (beam, contactor positions, stiffnesses and
+    dashpots, damping, load distribution, modes, basis) and initial state run
+    as one batch (:func:`impactbeam.solver.batch.integrate_batch`), with no
+    Python per case; ``solver.modes = "auto"`` runs case by case.
+
+    Parameters
+    ----------
+    cases : sequence of Case
+    progress : callable, optional
+        ``progress(n)`` with the number of cases finished so far.
+
+    Returns
+    -------
+    CaseMetrics
+    """
+    from .result.metrics import METRIC_UNITS, response_point
+    from .solver.batch import integrate_batch
+    from .solver.engine import pack_key
+
+    n = len(cases)
+    scalars = np.full((n, len(METRIC_UNITS)), np.nan)
+    status = np.full(n, -1, dtype=np.int64)
+    messages = [""] * n
+    errors: list[BaseException | None] = [None] * n
+    groups: dict[tuple, list[int]] = {}
+    points: dict[int, np.ndarray] = {}
+    for k, c in enumerate(cases):
+        try:
+            points[k] = _check_system(c.beam, c.contactors, c.excitation, c.initial, c.options, c.points, "exact")
+            if c.options.modes == "auto":
+                raise _CaseByCase
+            key = (pack_key(c.beam, c.contactors, c.damping, c.excitation, c.options, c.preload), c.initial,
+                   response_point(c.contactors, points[k])[0])
+            groups.setdefault(key, []).append(k)
+        except _CaseByCase:
+            groups.setdefault(("one", k), []).append(k)
+        except Exception as exc:
+            errors[k] = exc
+            messages[k] = " ".join(str(exc).split())
+    done = 0
+    for key, ks in groups.items():
+        first = cases[ks[0]]
+        if key[0] == "one":
+            try:
+                res = simulate_system(first.beam, first.contactors, damping=first.damping, excitation=first.excitation,
+                                      initial=first.initial, options=first.options, points=first.points,
+                                      preload=first.preload)
+                m = res.metrics(impacts=False)
+            except Exception as exc:
+                errors[ks[0]] = exc
+                messages[ks[0]] = " ".join(str(exc).split())
+            else:
+                scalars[ks[0]] = [np.nan if m[name] is None else m[name] for name in METRIC_UNITS]
+                status[ks[0]] = res.status
+                messages[ks[0]] = res.message
+        else:
+            x = key[2]
+            signs = [response_point(cases[k].contactors, points[k])[1] for k in ks]
+            br = integrate_batch(first.beam, [cases[k].contactors for k in ks], first.damping,
+                                 [cases[k].excitation for k in ks], first.initial, [cases[k].options for k in ks],
+                                 point=x, sign=np.array(signs), preload=first.preload, progress=None if progress is None else
+                                 (lambda j, done=done: progress(done + j)))
+            scalars[ks] = br.scalars
+            status[ks] = br.status
+            for j, k in enumerate(ks):
+                messages[k] = br.messages[j]
+                errors[k] = br.errors[j]
+                for text in br.warnings[j]:
+                    warn(text)
+        done += len(ks)
+        if progress is not None:
+            progress(done)
+    return CaseMetrics(scalars, status, messages, errors)
+
+
+class _CaseByCase(Exception):
+    """A case the batches do not take (``solver.modes = "auto"``)."""

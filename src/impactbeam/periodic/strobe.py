@@ -253,15 +253,16 @@ def analyse_steady_state(
     n, mism = detect_period(scaled, tolerance, max_period)
     before = settle_periods if settled_after is None else settled_after
     settling = still_settling(scaled, n, tolerance)
-    free = not smp.engaged.any() and not any(lo <= e.time <= hi for e in result.events)
+    ev_t, ev_impact = _event_arrays(result)
+    free = not smp.engaged.any() and not np.any((ev_t >= lo) & (ev_t <= hi))
     if free and n > 1:  # no contact over the record: a linear system, whose steady state has period 1
         settling = True
     if settling:
         n = 0
-    n_imp = sum(1 for e in result.events if e.kind == "impact" and lo <= e.time < hi)
+    n_imp = int(np.count_nonzero(ev_impact & (ev_t >= lo) & (ev_t < hi)))
     if n:
         reps = record_periods // n
-        in_reps = sum(1 for e in result.events if e.kind == "impact" and lo <= e.time < lo + reps * n * T)
+        in_reps = int(np.count_nonzero(ev_impact & (ev_t >= lo) & (ev_t < lo + reps * n * T)))
         ipp = in_reps / reps
     else:
         ipp = n_imp / record_periods
@@ -280,6 +281,15 @@ def analyse_steady_state(
         min=float(-ext[1, 0]), mismatch=float(mism), point=x0, window=(lo, hi), result=result,
         settled_after=before, warnings=warns,
     )
+
+
+def _event_arrays(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
+    """Event times and whether each is an impact (from the solution's arrays when it keeps them)."""
+    arrays = getattr(result.solution, "event_arrays", None)
+    if arrays is not None:
+        return arrays[0], arrays[1] == 1
+    t = np.array([e.time for e in result.events], dtype=float)
+    return t, np.array([e.kind == "impact" for e in result.events], dtype=bool)
 
 
 def run_periods(scenario: Scenario, periods: int, *, start_state: ModalState | None = None,

@@ -132,11 +132,16 @@ def _metric_point(result: ResultLike) -> tuple[float, float]:
 def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, Any]:
     """The metrics dictionary of :meth:`SimulationResult.metrics`.
 
-    All extrema of one call are found in one batch of the compiled kernel
-    (:meth:`~impactbeam.solver.solution.Solution.extrema`); with the
-    per-impact table, the minimum of ``u`` in a contact interval of the first
-    contactor is read from that interval's peak compression
-    (``u = -s w(a)`` there, so ``min u = -(peak compression + gap)``).
+    The exact solution computes them in one compiled call
+    (:meth:`~impactbeam.solver.solution.Solution.metric_arrays`, the same
+    code the batched runs of sweeps use, so a case gives the same bits alone
+    or in a batch); another solution (the ``solve_ivp`` reference) answers
+    the same extremum and integral queries itself, around the same compiled
+    rules (:mod:`impactbeam.solver._metrics`). The minimum of ``u`` in a
+    contact interval of the first contactor is read from that interval's
+    peak compression (``u = -s w(a)`` there, so ``min u = -(peak
+    compression + gap)``), and ``max_penetration`` is the largest compression
+    of the first contactor over the run.
 
     Parameters
     ----------
@@ -152,81 +157,101 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     """
     sol = result.solution
     x, sign = _metric_point(result)
-    t_end = sol.t_end
-    out: dict[str, Any] = {k: None for k in METRIC_UNITS}
-    out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
-    out["n_events"] = len(result.events)
-    rows = _contact_rows(result) if impacts else []
-    queries: list[tuple] = [(x, 0.0, t_end, sign, 0.0, None)]
-    if not result.contactors:
-        queries.append((x, 0.0, t_end, -sign, 0.0, None))
-    elif not impacts:  # with the table, the largest compression is the largest of its peaks
-        c0 = result.contactors[0]
-        queries.append((c0.position, 0.0, t_end, c0.direction, -c0.direction * c0.gap, 0))
-    first_peak = len(queries)
-    queries += [_peak_query(result, ci, a, be) for ci, a, _, be in rows]
-    ext = sol.extrema(queries)
-    peaks = ext[first_peak:, 0]
-    if not np.isfinite(ext[0, 0]):
-        if impacts:
-            out["impacts"] = []
-        return out
-    out["max_response"] = float(ext[0, 0])
-    t_max = float(ext[0, 1])
-    out["t_max"] = t_max
-    out["energy_residual"] = -float(np.sum(result.energy_jumps)) - float(np.sum(sol.release_losses()[1]))
-    if not result.contactors:
-        out["min_response"] = -float(ext[1, 0])
+    if hasattr(sol, "metric_arrays"):
+        scalars, rows = sol.metric_arrays(x, sign, impacts)
     else:
-        deepest = ext[1, 0] if not impacts else max((p for (ci, *_), p in zip(rows, peaks) if ci == 0), default=-np.inf)
-        out["max_penetration"] = max(float(deepest), 0.0) if np.isfinite(deepest) else 0.0
-        _contact_metrics(result, out, t_max, rows, peaks)
+        scalars, rows = _queried_arrays(result, x, sign, impacts)
+    out = metrics_dict(scalars)
+    arrays = getattr(sol, "event_arrays", None)
+    if arrays is not None:  # without making the Event tuples
+        out["events"] = [{"time": t, "kind": "impact" if k else "rebound", "contactor": c}
+                         for t, k, c in zip(arrays[0].tolist(), arrays[1].tolist(), arrays[2].tolist())]
+    else:
+        out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
     if impacts:
-        out["impacts"] = _impact_table(result, rows, peaks)
+        out["impacts"] = _impact_table(result, rows) if np.isfinite(scalars[0]) else []
     return out
 
 
-def _contact_metrics(result: ResultLike, out: dict[str, Any], t_max: float, rows: list, peaks) -> None:
-    """Impact count, first impact, free and contact durations and the minimum in contact."""
+def metrics_dict(scalars: np.ndarray) -> dict[str, Any]:
+    """The scalar metrics as the dictionary of :func:`compute_metrics` (None for NaN, counts as int).
+
+    Parameters
+    ----------
+    scalars : ndarray, (10,)
+        In the order of :data:`METRIC_UNITS`.
+    """
+    out: dict[str, Any] = {}
+    for key, v in zip(METRIC_UNITS, scalars.tolist()):
+        out[key] = None if v != v else (int(v) if key in _COUNTS else v)
+    return out
+
+
+_COUNTS = ("n_impacts", "n_events")
+
+
+def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> tuple[np.ndarray, tuple]:
+    """:meth:`~impactbeam.solver.solution.Solution.metric_arrays` for any solution, through its queries."""
+    from ..solver import kernels
+
+    K = kernels.for_work(len(result.events))
     sol = result.solution
-    c0 = result.contactors[0]
-    iv = contact_intervals(result, 0)
-    out["n_impacts"] = len(iv)
-    out["first_impact_time"] = iv[0][0] if iv else None
-    prev_end, nxt_start = 0.0, None
-    for a, b in iv:
-        if b <= t_max:
-            prev_end = b
-        elif a >= t_max:
-            nxt_start = a
-            break
-    out["free_duration"] = (nxt_start - prev_end) if nxt_start is not None else None
-    after = [(a, b) for a, b in iv if a >= t_max]
-    if not after:
-        return
-    a, b = after[0]
-    if math.isfinite(b):
-        out["contact_duration"] = b - a
-    if a >= sol.t_end:
-        return
-    known = [p for (ci, ra, _, _), p in zip(rows, peaks) if ci == 0 and ra == a]
-    if known:
-        peak = float(known[0])
-    else:  # the same query as the per-impact table's, so both paths give the same bits
-        peak = float(sol.extrema([_peak_query(result, 0, a, min(b, sol.t_end))])[0, 0])
-    if np.isfinite(peak):
-        out["min_response"] = -(peak + c0.gap)
-
-
-def _contact_rows(result: ResultLike) -> list[tuple[int, float, float, float]]:
-    """(contactor, start, end, end clipped to the solution) of every contact interval."""
-    t_end = result.solution.t_end
-    rows = []
-    for ci in range(len(result.contactors)):
-        for a, b in contact_intervals(result, ci):
-            if min(b, t_end) > a:
-                rows.append((ci, a, b, min(b, t_end)))
-    return rows
+    t_end = sol.t_end
+    con = result.contactors
+    nc = len(con)
+    ev_t = np.array([e.time for e in result.events], dtype=float)
+    ev_kind = np.array([e.kind == "impact" for e in result.events], dtype=np.int64)
+    ev_c = np.array([e.contactor for e in result.events], dtype=np.int64)
+    nev = ev_t.size
+    n = nev + nc + 1
+    rc, ra, rb, rbe = np.zeros(n, dtype=np.int64), np.zeros(n), np.zeros(n), np.zeros(n)
+    n_rows = int(K.contact_rows(ev_t, ev_kind, ev_c, nev, nc, float(t_end), rc, ra, rb, rbe)) if nc else 0
+    rc, ra, rb, rbe = rc[:n_rows], ra[:n_rows], rb[:n_rows], rbe[:n_rows]
+    queries: list[tuple] = [(x, 0.0, t_end, sign, 0.0, None)]
+    if not nc:
+        queries.append((x, 0.0, t_end, -sign, 0.0, None))
+    else:  # the largest compression of the first contactor over the run
+        c0 = con[0]
+        queries.append((c0.position, 0.0, t_end, c0.direction, -c0.direction * c0.gap, 0))
+    ext = sol.extrema(queries)
+    top, t_top = float(ext[0, 0]), float(ext[0, 1])
+    peaks = np.full(n_rows, np.nan)
+    contact = np.full(5, np.nan)
+    peak_after = np.nan
+    if nc:
+        K.first_contact(ev_t, ev_kind, ev_c, nev, t_top, contact)
+        a, b = contact[3], contact[4]
+        want = [i for i in range(n_rows) if table or (rc[i] == 0 and ra[i] == a)]
+        if want:
+            peaks[want] = sol.extrema([_peak_query(result, int(rc[i]), ra[i], rbe[i]) for i in want])[:, 0]
+        if np.isfinite(top) and np.isfinite(a) and a < t_end and not np.any((rc == 0) & (ra == a)):
+            peak_after = float(sol.extrema([_peak_query(result, 0, a, min(b, t_end))])[0, 0])
+    energy = 0.0
+    if np.isfinite(top):
+        dash = np.asarray(getattr(sol, "dashpots", np.zeros(nc)), dtype=float)
+        kst = np.array([c.stiffness for c in con], dtype=float)
+        jumps = np.ascontiguousarray(result.energy_jumps, dtype=float)
+        pen = np.ascontiguousarray(getattr(sol, "event_penetrations", np.zeros(nev)), dtype=float)
+        energy = (-K.pairwise_sum(jumps, jumps.size)
+                  - K.release_loss_sum(ev_c, ev_kind, pen, nev, dash, kst, np.empty(max(nev, 1))))
+    out = np.empty(K.N_SCALARS)
+    low, deepest = (float(ext[1, 0]), np.nan) if not nc else (np.nan, float(ext[1, 0]))
+    K.assemble(out, nev, top, t_top, low, energy, deepest, n_rows, rc, ra, peaks, contact, con[0].gap if nc else 0.0,
+               peak_after)
+    fpeaks, ints, d0, d1 = peaks.copy(), np.zeros(n_rows), np.full(n_rows, np.nan), np.full(n_rows, np.nan)
+    if table and n_rows:
+        dash = getattr(sol, "dashpots", np.zeros(nc))
+        ints = sol.integrals([(con[c].position, a, be) for c, a, be in zip(rc, ra, rbe)])
+        forced = [i for i in range(n_rows) if dash[rc[i]] > 0.0]
+        if forced:
+            fq = [_peak_query(result, int(rc[i]), ra[i], rbe[i]) + (dash[rc[i]] / con[rc[i]].stiffness,)
+                  for i in forced]
+            fpeaks[forced] = sol.extrema(fq)[:, 0]
+            for i in forced:
+                c = con[rc[i]]
+                w = sol.sample(np.array([c.position]), np.array([ra[i], rbe[i]])).w[:, 0]
+                d0[i], d1[i] = c.direction * w - c.gap
+    return out, (rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1)
 
 
 def _peak_query(result: ResultLike, ci: int, a: float, be: float) -> tuple:
@@ -264,43 +289,59 @@ def contact_forces(result: ResultLike, intervals: Sequence[tuple[int, float, flo
         return np.zeros(0), np.zeros(0)
     dash = getattr(sol, "dashpots", np.zeros(len(result.contactors)))
     cs = [result.contactors[ci] for ci, _, _ in intervals]
-    k = np.array([c.stiffness for c in cs])
     ints = sol.integrals([(c.position, a, b) for c, (_, a, b) in zip(cs, intervals)])
-    impulses = k * (np.array([c.direction for c in cs]) * ints - np.array([c.gap * (b - a) for c, (_, a, b)
-                                                                           in zip(cs, intervals)]))
-    rate = np.array([dash[ci] for ci, _, _ in intervals]) / k
+    rate = np.array([dash[ci] / c.stiffness for c, (ci, _, _) in zip(cs, intervals)])
     queries = [_peak_query(result, ci, a, b) + (r,) for (ci, a, b), r in zip(intervals, rate)]
     ask = [i for i in range(n) if compressions is None or rate[i] > 0.0]
     peaks = np.full(n, np.nan) if compressions is None else np.asarray(compressions, dtype=float).copy()
     if ask:
         peaks[ask] = sol.extrema([queries[i] for i in ask])[:, 0]
+    d0, d1 = np.full(n, np.nan), np.full(n, np.nan)
     forced = np.flatnonzero(rate > 0.0)
-    if forced.size:  # the dashpot's share of the impulse: c [d] over each interval, one evaluation for all
+    if forced.size:  # the compressions at the ends, for the dashpot's share c [d]: one evaluation for all
         xs = np.unique([cs[i].position for i in forced])
         ts = np.array([t for i in forced for t in intervals[i][1:]])
         w = sol.sample(xs, ts).w
         col = np.searchsorted(xs, [cs[i].position for i in forced])
         for j, i in enumerate(forced):
-            d = cs[i].direction * w[2 * j: 2 * j + 2, col[j]] - cs[i].gap
-            impulses[i] += dash[intervals[i][0]] * float(d[1] - d[0])
-    return k * np.maximum(peaks, 0.0), impulses
+            d0[i], d1[i] = cs[i].direction * w[2 * j: 2 * j + 2, col[j]] - cs[i].gap
+    return _forces(result, intervals, peaks, ints, d0, d1)
 
 
-def _impact_table(result: ResultLike, rows: list, peaks) -> list[dict[str, Any]]:
-    """Duration, peak force and impulse of every contact interval (exact, closed form; :func:`contact_forces`)."""
-    if not rows:
-        return []
-    force_peaks, impulses = contact_forces(result, [(ci, a, be) for ci, a, _, be in rows], peaks)
+def _forces(result: ResultLike, intervals: Sequence[tuple[int, float, float]], peaks: Sequence[float],
+            ints: Sequence[float], d0: Sequence[float], d1: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """The rule of :func:`contact_forces`: peak ``k max(peak, 0)``, impulse ``k (s int w - gap T) + c_d [d]``.
+
+    ``peaks`` are the maxima of ``d + (c_d / k) d'`` (of ``d`` without
+    dashpot), ``ints`` the integrals of ``w`` at the contactor, ``d0, d1`` the
+    compressions at the ends (read only with a dashpot).
+    """
+    dash = getattr(result.solution, "dashpots", np.zeros(len(result.contactors)))
+    force, impulse = np.zeros(len(intervals)), np.zeros(len(intervals))
+    for i, ((ci, a, b), peak, iw, e0, e1) in enumerate(zip(intervals, peaks, ints, d0, d1)):
+        c = result.contactors[ci]
+        force[i] = c.stiffness * max(peak, 0.0)
+        impulse[i] = c.stiffness * (c.direction * iw - c.gap * (b - a))
+        if dash[ci] > 0.0:
+            impulse[i] += dash[ci] * (e1 - e0)
+    return force, impulse
+
+
+def _impact_table(result: ResultLike, rows: tuple) -> list[dict[str, Any]]:
+    """Duration, peak force and impulse of every contact interval (exact, closed form; :func:`_forces`)."""
+    rc, ra, rb, rbe, _, fpeaks, ints, d0, d1 = (r.tolist() for r in rows)
+    force, impulse = _forces(result, list(zip(rc, ra, rbe)), fpeaks, ints, d0, d1)
     out = []
-    for (ci, a, b, be), peak, impulse in zip(rows, force_peaks, impulses):
+    for ci, a, b, peak, imp in zip(rc, ra, rb, force.tolist(), impulse.tolist()):
+        finite = math.isfinite(b)
         out.append(
             {
                 "contactor": ci,
                 "start": a,
-                "end": b if math.isfinite(b) else None,
-                "duration": (b - a) if math.isfinite(b) else None,
-                "peak_force": float(peak),
-                "impulse": float(impulse),
+                "end": b if finite else None,
+                "duration": (b - a) if finite else None,
+                "peak_force": peak,
+                "impulse": imp,
             }
         )
     out.sort(key=lambda d: (d["start"], d["contactor"]))

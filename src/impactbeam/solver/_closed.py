@@ -46,10 +46,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "kernel", "setup", "segment_setup", "state_at",
-           "project", "integral_of", "derivatives", "curvature_bound", "jerk_bound", "workspace"]
+           "project", "integral_of", "derivatives", "curvature_bound", "jerk_bound", "workspace", "copy_into",
+           "ipow"]
 
 REG_UNDER = 0
 REG_CRITICAL = 1
@@ -195,17 +196,23 @@ def project(V, U, base, a, om, h0, dh0, P, AL, Om, VH, VD, PV, rows):  # pragma:
 
 
 @njit(cache=True, nogil=True)
-def _particular_bound(p, Om, tmax, order):  # pragma: no cover - compiled
-    """Bound on the ``order``-th (2 or 3) derivative of the particular part ``p`` on ``[0, tmax]``."""
+def _particular_curvature(p, Om, tmax):  # pragma: no cover - compiled
+    """Bound on the second derivative of the particular part ``p`` on ``[0, tmax]``."""
     W = abs(Om)
-    if order == 2:
-        m = 2.0 * abs(p[2]) + 6.0 * abs(p[3]) * tmax
-        if Om != 0.0:
-            m += W * W * (abs(p[4]) + abs(p[5])) + (abs(p[6]) + abs(p[7])) * (2.0 * W + W * W * tmax)
-        return m
+    m = 2.0 * abs(p[2]) + 6.0 * abs(p[3]) * tmax
+    if Om != 0.0:
+        m += W * W * (abs(p[4]) + abs(p[5])) + (abs(p[6]) + abs(p[7])) * (2.0 * W + W * W * tmax)
+    return m
+
+
+@njit(cache=True, nogil=True)
+def _particular_jerk(p, Om, tmax):  # pragma: no cover - compiled
+    """Bound on the third derivative of the particular part ``p`` on ``[0, tmax]``."""
+    W = abs(Om)
     m = 6.0 * abs(p[3])
     if Om != 0.0:
-        m += W**3 * (abs(p[4]) + abs(p[5])) + (abs(p[6]) + abs(p[7])) * (3.0 * W * W + W**3 * tmax)
+        W3 = W * W * W  # as numba's constant power: one rounding per product
+        m += W3 * (abs(p[4]) + abs(p[5])) + (abs(p[6]) + abs(p[7])) * (3.0 * W * W + W3 * tmax)
     return m
 
 
@@ -221,7 +228,7 @@ def curvature_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - 
     """
     tmax = max(tau_end, 0.0)
     for c in range(out.size):
-        out[c] = _particular_bound(PV[c], Om, tmax, 2)
+        out[c] = _particular_curvature(PV[c], Om, tmax)
     for n in range(om.size):
         o = om[n]
         k = 2.0 * a[n] + o
@@ -243,7 +250,7 @@ def jerk_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compi
     """
     tmax = max(tau_end, 0.0)
     for c in range(out.size):
-        out[c] = _particular_bound(PV[c], Om, tmax, 3)
+        out[c] = _particular_jerk(PV[c], Om, tmax)
     for n in range(om.size):
         o = om[n]
         k = 2.0 * a[n] + o
@@ -277,13 +284,29 @@ def curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, out, work_h,
 
 
 @njit(cache=True, nogil=True)
+def ipow(x, n):  # pragma: no cover - compiled
+    """``x**n`` for an integer ``n >= 0`` by repeated squaring, as numba computes a float to an integer power.
+
+    Written out so that the interpreted kernels (:mod:`~impactbeam.solver.kernels`)
+    round exactly as the compiled ones (Python's ``**`` calls ``pow``).
+    """
+    r = 1.0
+    while n != 0:
+        if n & 1:
+            r *= x
+        n >>= 1
+        x *= x
+    return r
+
+
+@njit(cache=True, nogil=True)
 def _load_derivative(A, B, D, E, Om, sphi, cphi, j):  # pragma: no cover - compiled
     """``d^j/dtau^j (A + B tau + D sin theta + E cos theta)`` at ``tau = 0``."""
     if j == 0:
         return A + D * sphi + E * cphi
     if j == 1:
         return B + Om * (D * cphi - E * sphi)
-    s = Om**j
+    s = ipow(Om, j)
     r = j % 4
     if r == 0:
         return s * (D * sphi + E * cphi)
@@ -433,6 +456,17 @@ def alpha_at(AL, tau, Om, phi, out):  # pragma: no cover - compiled
     s = math.sin(Om * tau + phi) if Om != 0.0 else math.sin(phi)
     for n in range(out.size):
         out[n] = AL[n, 0] + AL[n, 1] * tau + AL[n, 2] * s
+
+
+@njit(cache=True, nogil=True)
+def copy_into(dst, src):  # pragma: no cover - compiled
+    """``dst[:] = src`` for two 1-D arrays of one length, as a loop.
+
+    (A slice assignment compiles numba's shape check and its error message,
+    string formatting included: seconds of compile time for nothing.)
+    """
+    for i in range(dst.size):
+        dst[i] = src[i]
 
 
 @njit(cache=True, nogil=True)

@@ -26,16 +26,37 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 from ._closed import (
-    NP, alpha_at, curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup, state_at,
-    workspace,
+    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup,
+    state_at, workspace,
 )
-from ._events import brent
+from ._events import SLOPE, brent
 from ._loop import load_value, to_modal
 
-__all__ = ["sample", "extremum", "integral"]
+__all__ = ["sample", "extremum", "extremum_query", "integral", "integral_query", "first_segment", "dense_work",
+           "row_ceiling"]
+
+ROW0 = np.int64(0)  # int64 values, not literals: one compiled specialisation of brent and project
+ONE_ROW = np.int64(1)
+
+
+@njit(cache=True, nogil=True)
+def first_segment(t1, lo):  # pragma: no cover - compiled
+    """``max(searchsorted(t1, lo) - 1, 0)``: the segment before the first one ending at or after ``lo``.
+
+    (A binary search written out: numba's ``searchsorted`` compiles slowly.)
+    """
+    left = 0
+    right = t1.size
+    while left < right:
+        mid = (left + right) >> 1
+        if t1[mid] < lo:
+            left = mid + 1
+        else:
+            right = mid
+    return max(left - 1, 0)
 
 
 @njit(cache=True, nogil=True)
@@ -115,8 +136,8 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
             out_rows[i, r] = acc
             out_drows[i, r] = dacc
         if want_modal:
-            out_eta[i, :] = e
-            out_deta[i, :] = d
+            copy_into(out_eta[i], e)
+            copy_into(out_deta[i], d)
         if want_energy:
             u = load_value(kp, tq[i], pt0, pconst, pslope, pamp, pOm, pphase)
             kin = 0.0
@@ -149,6 +170,43 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
             energies[i, 2] = lp
             energies[i, 3] = dp - cp
             energies[i, 4] = cp
+
+
+@njit(cache=True, nogil=True)
+def sample_row(t, Wq, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
+               kst, pt0, pconst, pslope, pamp, pOm, pphase, work):  # pragma: no cover - compiled
+    """``Wq[s] . eta(t)``: one row at one time, as :func:`sample` evaluates it (``work`` from :func:`dense_work`).
+
+    The segment is the last one starting at or before ``t`` (an event time
+    belongs to the segment it starts).
+    """
+    ws, alpha, e, d = work[0], work[9], work[10], work[11]
+    h0, dh0, P = ws[0], ws[1], ws[2]
+    AL = ws[7]
+    left = 0
+    right = seg_t0.size
+    while left < right:  # searchsorted(seg_t0, t, "right")
+        mid = (left + right) >> 1
+        if seg_t0[mid] <= t:
+            left = mid + 1
+        else:
+            right = mid
+    j = min(max(left - 1, 0), seg_t0.size - 1)
+    s = seg_s[j]
+    Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side, kst, pt0,
+                     pconst, pslope, pamp, pOm, pphase, ws)
+    tau = t - seg_t0[j]
+    nm = seg_eta.shape[1]
+    z = np.empty(nm)
+    dz = np.empty(nm)
+    state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz)
+    if gen[s]:
+        alpha_at(AL, tau, Om, phi, alpha)
+    to_modal(gen[s], G[s], z, dz, alpha, e, d)
+    acc = 0.0
+    for n in range(nm):
+        acc += Wq[s, n] * e[n]
+    return acc
 
 
 @njit(cache=True, nogil=True)
@@ -239,7 +297,7 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
             continue  # concave with no interior stationary point: the ends hold the maximum
         tm = 0.5 * (t0 + t1)
         if concave:  # the one interior maximum: Brent on u'
-            tm = brent(1, 0, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+            tm = brent(SLOPE, ROW0, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
             if not (t0 < tm < t1):
                 tm = 0.5 * (t0 + t1)
         um, dm, cm = _row3(tm, reg, a, w, om, VH, VD, base, PV, Om, phi)
@@ -269,112 +327,162 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
 
 
 @njit(cache=True, nogil=True)
+def dense_work(nm):  # pragma: no cover - compiled
+    """Work arrays of :func:`extremum_query` and :func:`integral_query` for ``nm`` coordinates."""
+    return (workspace(nm), np.empty((1, nm)), np.empty((1, nm)), np.zeros(1), np.empty((1, nm)), np.empty((1, nm)),
+            np.empty((1, NP)), np.empty(1), np.empty(1), np.zeros(nm), np.empty(nm), np.empty(nm),
+            np.empty((128, 8)))
+
+
+@njit(cache=True, nogil=True)
+def row_ceiling(VH, VD, PV, base, reg, a, wd, L):  # pragma: no cover - compiled
+    """An upper bound of row 0 of a projection on ``[0, L]``, and the magnitude it is made of.
+
+    A homogeneous contribution ``f`` (value ``VH``, slope ``VD`` at 0, decay
+    ``a >= 0``) never exceeds ``sqrt(VH^2 + ((VD + a VH) / w_d)^2)`` when
+    under-damped, nor ``|VH| + |VD + a VH| L`` otherwise (``e^{-a tau}`` times
+    cos/sin, 1/tau or cosh/sinh, each bounded so); the particular part is
+    bounded term by term.
+    """
+    p = PV[0]
+    up = base[0] + p[0] + abs(p[1]) * L + (abs(p[2]) + abs(p[3]) * L) * L * L
+    up += math.sqrt(p[4] * p[4] + p[5] * p[5]) + L * math.sqrt(p[6] * p[6] + p[7] * p[7])
+    mag = abs(base[0]) + abs(up - base[0])
+    for n in range(wd.size):
+        if a[n] < 0.0:
+            return np.inf, np.inf  # a growing coordinate: no ceiling (never so: damping dissipates)
+        vh = VH[0, n]
+        vd = VD[0, n] + a[n] * vh
+        if reg[n] == 0:
+            r = vd / wd[n]
+            amp = math.sqrt(vh * vh + r * r)
+        else:
+            amp = abs(vh) + abs(vd) * L
+        up += amp
+        mag += amp
+    return up, mag
+
+
+@njit(cache=True, nogil=True)
+def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg_t1, seg_s, seg_k, seg_eta,
+                   seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp,
+                   pOm, pphase, work):  # pragma: no cover - compiled
+    """Maximum of ``sign (Wq[s] . (eta + rate eta') + offset)`` over ``[lo, hi]`` and its time.
+
+    ``eta`` are the modal coordinates in slot ``s``'s frame (``rate``: a
+    velocity term, e.g. a dashpot's force). Only segments whose state has
+    contactor ``cond`` engaged count (``cond < 0``: all); ``(-inf, nan)``
+    when none qualifies. ``work`` from :func:`dense_work`.
+
+    A segment whose ceiling (:func:`row_ceiling`, less a round-off margin)
+    cannot reach the best value found so far is skipped: its branch and bound
+    could not have changed that value, so the result is the same to the bit,
+    only sooner.
+    """
+    ws, V, U, base, VH, VD, PV, M, M3, alpha, e, d, stack = work
+    h0, dh0, P = ws[0], ws[1], ws[2]
+    AL = ws[7]
+    nm = seg_eta.shape[1]
+    best = -np.inf
+    tbest = np.nan
+    j0 = first_segment(seg_t1, lo)
+    # a first lower bound from the segment starts inside the interval (no closed form needed)
+    for j in range(j0, seg_t0.size):
+        if seg_t0[j] > hi:
+            break
+        s = seg_s[j]
+        if seg_t0[j] >= lo and (cond < 0 or ((smask[s] >> cond) & 1) == 1):
+            if gen[s]:
+                Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask,
+                                 gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
+                alpha_at(AL, 0.0, Om, phi, alpha)
+            to_modal(gen[s], G[s], seg_eta[j], seg_deta[j], alpha, e, d)
+            v = 0.0
+            for n in range(nm):
+                v += Wq[s, n] * (e[n] + rate * d[n])
+            v = sign * (v + offset)
+            if v > best:
+                best = v
+                tbest = seg_t0[j]
+    for j in range(j0, seg_t0.size):
+        if seg_t0[j] > hi:
+            break
+        a0 = max(seg_t0[j], lo)
+        a1 = min(seg_t1[j], hi)
+        if a1 < a0:
+            continue
+        s = seg_s[j]
+        if cond >= 0 and ((smask[s] >> cond) & 1) == 0:
+            continue
+        Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
+                         kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
+        slot_row(gen[s], G[s], Wq[s], rate, V[0], U[0])
+        for n in range(nm):
+            V[0, n] *= sign
+            U[0, n] *= sign
+        base[0] = sign * offset
+        project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, ONE_ROW)
+        L = a1 - seg_t0[j]
+        up, mag = row_ceiling(VH, VD, PV, base, reg[s], dec[s], wdh[s], L)
+        if up + 1e-9 * mag < best:
+            continue  # no value of this segment reaches best: its search would change nothing
+        curvature_bound(VH, VD, dec[s], om[s], PV, Om, L, M)
+        jerk_bound(VH, VD, dec[s], om[s], PV, Om, L, M3)
+        best, tloc = _segment_max(a0 - seg_t0[j], L, M[0], M3[0], best, atol, xtol,
+                                  stack, reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi)
+        if not np.isnan(tloc):
+            tbest = tloc + seg_t0[j]
+    return best, tbest
+
+
+@njit(cache=True, nogil=True)
 def extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val, out_t,
              seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
              kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
-    """Maxima of ``sign[q] (Wr[row[q], s] . (eta + rate[q] eta') + offset[q])`` over ``[lo[q], hi[q]]``.
+    """:func:`extremum_query` for each query ``q``, on the rows ``Wr[row[q]]``: values and times into ``out_*``."""
+    work = dense_work(seg_eta.shape[1])
+    for q in range(lo.size):
+        out_val[q], out_t[q] = extremum_query(
+            lo[q], hi[q], sign[q], offset[q], rate[q], Wr[row[q]], cond_bit[q], atol, xtol, seg_t0, seg_t1, seg_s,
+            seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope,
+            pamp, pOm, pphase, work)
 
-    Also their times. ``eta`` are the modal coordinates in slot ``s``'s frame
-    (``rate``: a velocity term, e.g. a dashpot's force). Query ``q`` counts
-    only segments whose state has contactor ``cond_bit[q]`` engaged
-    (``cond_bit < 0``: all segments); ``(-inf, nan)`` when none qualifies.
-    """
-    nm = seg_eta.shape[1]
-    ws = workspace(nm)
+
+@njit(cache=True, nogil=True)
+def integral_query(lo, hi, Wq, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G,
+                   smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, work):  # pragma: no cover
+    """``int_lo^hi Wq[s] . eta dt`` over the segments, in closed form (``work`` from :func:`dense_work`)."""
+    ws, V, U, base, VH, VD, PV = work[0], work[1], work[2], work[3], work[4], work[5], work[6]
     h0, dh0, P = ws[0], ws[1], ws[2]
     AL = ws[7]
-    V = np.empty((1, nm))
-    U = np.empty((1, nm))
-    base = np.empty(1)
-    VH = np.empty((1, nm))
-    VD = np.empty((1, nm))
-    PV = np.empty((1, NP))
-    M = np.empty(1)
-    M3 = np.empty(1)
-    alpha = np.zeros(nm)
-    e = np.empty(nm)
-    d = np.empty(nm)
-    stack = np.empty((128, 8))
-    for q in range(lo.size):
-        best = -np.inf
-        tbest = np.nan
-        j0 = max(np.searchsorted(seg_t1, lo[q]) - 1, 0)
-        # a first lower bound from the segment starts inside the interval (no closed form needed)
-        for j in range(j0, seg_t0.size):
-            if seg_t0[j] > hi[q]:
-                break
-            s = seg_s[j]
-            if seg_t0[j] >= lo[q] and (cond_bit[q] < 0 or ((smask[s] >> cond_bit[q]) & 1) == 1):
-                if gen[s]:
-                    Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask,
-                                     gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
-                    alpha_at(AL, 0.0, Om, phi, alpha)
-                to_modal(gen[s], G[s], seg_eta[j], seg_deta[j], alpha, e, d)
-                v = 0.0
-                for n in range(nm):
-                    v += Wr[row[q], s, n] * (e[n] + rate[q] * d[n])
-                v = sign[q] * (v + offset[q])
-                if v > best:
-                    best = v
-                    tbest = seg_t0[j]
-        for j in range(j0, seg_t0.size):
-            if seg_t0[j] > hi[q]:
-                break
-            a0 = max(seg_t0[j], lo[q])
-            a1 = min(seg_t1[j], hi[q])
-            if a1 < a0:
-                continue
-            s = seg_s[j]
-            if cond_bit[q] >= 0 and ((smask[s] >> cond_bit[q]) & 1) == 0:
-                continue
-            Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
-                             kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
-            slot_row(gen[s], G[s], Wr[row[q], s], rate[q], V[0], U[0])
-            for n in range(nm):
-                V[0, n] *= sign[q]
-                U[0, n] *= sign[q]
-            base[0] = sign[q] * offset[q]
-            project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, 1)
-            curvature_bound(VH, VD, dec[s], om[s], PV, Om, a1 - seg_t0[j], M)
-            jerk_bound(VH, VD, dec[s], om[s], PV, Om, a1 - seg_t0[j], M3)
-            best, tloc = _segment_max(a0 - seg_t0[j], a1 - seg_t0[j], M[0], M3[0], best, atol, xtol,
-                                      stack, reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi)
-            if not np.isnan(tloc):
-                tbest = tloc + seg_t0[j]
-        out_val[q] = best
-        out_t[q] = tbest
+    base[0] = 0.0
+    total = 0.0
+    j0 = first_segment(seg_t1, lo)
+    for j in range(j0, seg_t0.size):
+        if seg_t0[j] > hi:
+            break
+        a0 = max(seg_t0[j], lo)
+        a1 = min(seg_t1[j], hi)
+        if a1 <= a0:
+            continue
+        s = seg_s[j]
+        Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
+                         kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
+        slot_row(gen[s], G[s], Wq[s], 0.0, V[0], U[0])
+        project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, ONE_ROW)
+        # the row from a0: its homogeneous part restarted there, the particular part shifted
+        total += integral_of(VH, VD, PV, reg[s], dec[s], wdh[s], om[s], Om, phi, a1 - seg_t0[j])
+        if a0 > seg_t0[j]:
+            total -= integral_of(VH, VD, PV, reg[s], dec[s], wdh[s], om[s], Om, phi, a0 - seg_t0[j])
+    return total
 
 
 @njit(cache=True, nogil=True)
 def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen,
              G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
     """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form."""
-    nm = seg_eta.shape[1]
-    ws = workspace(nm)
-    h0, dh0, P, lA, lB, lD, lE, AL = ws
-    V = np.empty((1, nm))
-    U = np.empty((1, nm))
-    base = np.zeros(1)
-    VH = np.empty((1, nm))
-    VD = np.empty((1, nm))
-    PV = np.empty((1, NP))
+    work = dense_work(seg_eta.shape[1])
     for q in range(lo.size):
-        total = 0.0
-        j0 = max(np.searchsorted(seg_t1, lo[q]) - 1, 0)
-        for j in range(j0, seg_t0.size):
-            if seg_t0[j] > hi[q]:
-                break
-            a0 = max(seg_t0[j], lo[q])
-            a1 = min(seg_t1[j], hi[q])
-            if a1 <= a0:
-                continue
-            s = seg_s[j]
-            Om, phi = _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side,
-                             kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
-            slot_row(gen[s], G[s], Wr[row[q], s], 0.0, V[0], U[0])
-            project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, 1)
-            # the row from a0: its homogeneous part restarted there, the particular part shifted
-            total += integral_of(VH, VD, PV, reg[s], dec[s], wdh[s], om[s], Om, phi, a1 - seg_t0[j])
-            if a0 > seg_t0[j]:
-                total -= integral_of(VH, VD, PV, reg[s], dec[s], wdh[s], om[s], Om, phi, a0 - seg_t0[j])
-        out[q] = total
+        out[q] = integral_query(lo[q], hi[q], Wr[row[q]], seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec,
+                                wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm,
+                                pphase, work)

@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
 from ._closed import EPS, curvature_bound_at, derivatives, kernel, particular
 
@@ -41,6 +41,10 @@ __all__ = ["row_at", "brent", "safe_step", "first_event", "scan", "departure"]
 
 RTOL = 4.0 * EPS
 _STACK = 96
+# what brent() solves for: passed as int64 values, not literal constants, so that numba compiles one
+# specialisation of brent, _f and row_at (a literal argument compiles a function once per value)
+VALUE = np.int64(0)
+SLOPE = np.int64(1)
 
 
 @njit(cache=True, nogil=True)
@@ -177,7 +181,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
                 if M <= 0.0 or safe_step(g0 + tol_h, d0, M) + safe_step(g1 + tol_h, -d1, M) >= L:
                     continue
             elif not touch0 and (_monotone(d0, d1, M, L, -1.0) or L <= xtol):
-                return brent(0, c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+                return brent(VALUE, c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
             elif touch0 and L <= xtol:
                 return t0  # from the surface straight into the stop
             if L <= xtol:
@@ -188,7 +192,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
             if _monotone(d0, d1, M, L, 1.0) or _monotone(d0, d1, M, L, -1.0):
                 continue  # monotone: no turn-back inside, at most an upward crossing
             if d0 > 0.0 and d1 <= 0.0 and (L <= xtol or g1 <= 0.0):
-                r = brent(1, c, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+                r = brent(SLOPE, c, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
                 gr, dr = row_at(c, r, reg, a, w, om, VH, VD, base, PV, Om, phi)
                 if gr <= 0.0:
                     return r
@@ -224,21 +228,25 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
 
 
 @njit(cache=True, nogil=True)
-def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg, a, w, om, VH, VD, base, PV, Om, phi,
-         work_h, work_d):
+def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, stack, reg, a, w, om, VH, VD, base, PV,
+         Om, phi, work_h, work_d):
     # pragma: no cover - compiled
     """Advance from ``tau0`` to the first switching event before ``tau_end``.
 
     ``g, dg`` hold the openings at ``tau0`` on entry; ``M`` their curvature
     bounds, refreshed every 32 steps from the projected rows (``work_h``,
-    ``work_d``: scratch arrays shaped like ``VH``). Returns ``(tau, c, n)``:
-    the event time and row, ``c = -1`` if none up to ``tau_end``, or ``c = -2``
-    when ``budget`` evaluations were spent first (``tau`` is then the point
-    reached, every row proven consistent up to it); ``n`` evaluations used.
+    ``work_d``: scratch arrays shaped like ``VH``). ``used0`` steps of this
+    segment's scan were taken before ``tau0`` (0 from the segment start;
+    more when a scan stopped by its budget resumes, with ``g, dg, M`` as it
+    left them, so that a resumed scan takes exactly the steps of one that was
+    never stopped). Returns ``(tau, c, n)``: the event time and row, ``c = -1``
+    if none up to ``tau_end``, or ``c = -2`` when ``budget`` more steps were
+    taken first (``tau`` is then the point reached, every row proven
+    consistent up to it); ``n`` the steps of the segment so far.
     """
     nc = g.size
     tau = tau0
-    used = 0
+    used = used0
     while tau < tau_end:
         step = tau_end - tau
         for c in range(nc):
@@ -275,7 +283,7 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, budget, stack, reg
             dg[c] = dgb[c]
         if used % 32 == 0:  # a decaying response earns longer steps
             curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d)
-        if used >= budget and tau < tau_end:
+        if used - used0 >= budget and tau < tau_end:
             return tau, -2, used
     return tau_end, -1, used
 

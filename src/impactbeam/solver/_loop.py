@@ -43,7 +43,9 @@ the arrays passed in):
   ``ic[REQ_B]`` is missing;
 * ``NEED_SPACE``: a record array is full;
 * ``CHECKPOINT``: the evaluation budget of one call is spent (progress
-  reports and Ctrl-C are handled by Python there);
+  reports and Ctrl-C are handled by Python there; a scan stopped inside a
+  segment resumes exactly where it was, so the solution does not depend on
+  the budget or on any return to Python);
 * ``DONE`` / ``CHATTER``: the run ended, at ``end_time`` or at the
   chattering guard (``max_events`` events, or endless switching at one
   instant).
@@ -54,19 +56,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ._jit import njit
 
-from ._closed import NP, alpha_at, curvature_bound, particular, project, segment_setup, state_at, workspace
+from ._closed import NP, alpha_at, copy_into, curvature_bound, particular, project, segment_setup, state_at, workspace
 from ._events import departure, scan
 
-DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
-# integer carry
-I_SLOT, I_PIECE, I_JUST, I_PENDING, I_NSEG, I_NEV, I_NJUMP, I_NSLOTS, I_NTR = 0, 1, 2, 3, 4, 5, 6, 7, 8
-I_WARN_C, REQ_A, REQ_B, I_SKIP, I_EVALS, I_SAME, I_WARN_N = 9, 10, 11, 12, 13, 14, 15
-N_INT = 16
-# float carry
-F_T, F_LAST_T, F_WARN_T, F_WARN_MOVED, F_WARN_SCALE = 0, 1, 2, 3, 4
-N_FLOAT = 5
+from ._codes import (  # noqa: E402 - status codes and the carry's layout, shared with the Python side
+    CHATTER, CHECKPOINT, DONE, F_LAST_T, F_T, F_TAU, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T, I_EVALS, I_JUST, I_NEV,
+    I_NJUMP, I_NSEG, I_NSLOTS, I_NTR, I_PENDING, I_PIECE, I_RESUME, I_SAME, I_SLOT, I_USED, I_WARN_C, I_WARN_N,
+    N_FLOAT, N_INT, NEED_SPACE, NEED_STATE, NEED_TRANSFER, REQ_A, REQ_B,
+)
+
 KMAX = 5  # highest derivative used to judge a tangency
 ROW_MAIN, ROW_PHASE = 0, 1  # a contactor's switching row; the end of its released phase
 
@@ -77,6 +77,12 @@ def _dot(x, y):  # pragma: no cover - compiled
     for n in range(x.size):
         s += x[n] * y[n]
     return s
+
+
+@njit(cache=True, nogil=True)
+def _zero(x):  # pragma: no cover - compiled
+    for i in range(x.size):
+        x[i] = 0
 
 
 @njit(cache=True, nogil=True)
@@ -98,8 +104,8 @@ def to_modal(gen, G, z, dz, alpha, e, d):  # pragma: no cover - compiled
     """Modal-frame displacement ``e`` and velocity ``d`` of a slot's coordinates ``z, z'``."""
     nm = z.size
     if gen == 0:
-        e[:] = z
-        d[:] = dz
+        copy_into(e, z)
+        copy_into(d, dz)
         return
     for m in range(nm):
         se = 0.0
@@ -182,11 +188,11 @@ def _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm,
     for n in range(nm):
         e1[n] = _dot(T[n], own_e)
         d1[n] = _dot(T[n], own_d)
-    own_e[:] = e1
-    own_d[:] = d1
+    copy_into(own_e, e1)
+    copy_into(own_d, d1)
     if gen[ns] == 0:
-        eta[:] = own_e
-        deta[:] = own_d
+        copy_into(eta, own_e)
+        copy_into(deta, own_d)
     else:  # the new state's coordinates: z = H0 x, z' = H1 x + alpha(t)
         for n in range(nm):
             al = LW[ns, 1, n] * u_now + LW[ns, 3, n]
@@ -268,7 +274,7 @@ def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD
         if bad:
             t = fc[F_T]
             if t != fc[F_LAST_T]:
-                toggles[:] = 0
+                _zero(toggles)
                 fc[F_LAST_T] = t
             toggles[c] += 1
             if toggles[c] <= 2:
@@ -279,10 +285,16 @@ def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD
 @njit(cache=True, nogil=True)
 def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, tr_to, gap, side, kst, dash,
         pt0, pt1, pconst, pslope, pamp, pOm, pphase,
-        T_end, tol_h, xtol, max_events, budget, fc, ic, eta, deta, own_e, own_d, toggles, phase,
+        T_end, tol_h, xtol, max_events, budget, fc, ic, eta, deta, own_e, own_d, toggles, phase, held,
         seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps):
     # pragma: no cover - compiled
-    """Run (or resume) the event loop; returns a status code (module docstring)."""
+    """Run (or resume) the event loop; returns a status code (module docstring).
+
+    A scan stopped by the budget (``CHECKPOINT`` inside a segment) keeps its
+    place, openings and bounds in ``fc[F_TAU]``, ``ic[I_USED]`` and ``held``
+    (``3 * max(2 n_c, 1)`` floats) and resumes from there: the solution does
+    not depend on where the run returned to Python.
+    """
     nm = eta.size
     nc = gap.size
     nrm = 2 * nc
@@ -313,7 +325,7 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
             t = fc[F_T]
             if t != fc[F_LAST_T]:
                 fc[F_LAST_T] = t
-                toggles[:] = 0
+                _zero(toggles)
                 ic[I_SAME] = 0
             u_now = load_value(ic[I_PIECE], t, pt0, pconst, pslope, pamp, pOm, pphase) if ic[I_PIECE] < pt0.size else 0.0
             st = _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm, tr_from, tr_to,
@@ -336,6 +348,7 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
         t_end = min(pt1[kp], T_end)
         tau_end = t_end - t
         project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, nr)
+        resume = ic[I_RESUME] == 1
         for r in range(nr):
             pv, pd = particular(PV[r], 0.0, Om, phi)
             g[r] = base[r] + pv
@@ -343,7 +356,7 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
             for n in range(nm):
                 g[r] += VH[r, n]
                 dg[r] += VD[r, n]
-        if ic[I_SKIP] == 0 and nr > 0:
+        if not resume and nr > 0:
             r_bad = _judge_start(ic, fc, g, nr, rowc, V, U, base, dec[s], om[s], eta, deta, lA, lB, lD, lE, AL,
                                  Om, phi, toggles, tol_h, dvec, mag)
             if r_bad >= 0:
@@ -357,16 +370,36 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
                 continue
         if ic[I_NSEG] + 1 > seg_t0.size:
             return NEED_SPACE
-        curvature_bound(VH[:nr], VD[:nr], dec[s], om[s], PV[:nr], Om, tau_end, M[:nr])
+        tau0 = 0.0
+        used0 = 0
+        if resume:  # the scan of this segment stopped at a checkpoint: on from where it was
+            tau0 = fc[F_TAU]
+            used0 = ic[I_USED]
+            for r in range(nr):
+                g[r] = held[r]
+                dg[r] = held[nrm + r]
+                M[r] = held[2 * nrm + r]
+            ic[I_RESUME] = 0
+        else:
+            curvature_bound(VH[:nr], VD[:nr], dec[s], om[s], PV[:nr], Om, tau_end, M[:nr])
         wmax = 0.0
         for n in range(nm):
             wmax = max(wmax, om[s, n])
         dmin = math.pi / (4.0 * wmax) if wmax > 0.0 else tau_end
-        tau_e, ch, used = scan(0.0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h,
+        tau_e, ch, used = scan(tau0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h, used0,
                                budget - evals, stack, reg[s], dec[s], wdh[s], om[s], VH[:nr], VD[:nr], base[:nr],
                                PV[:nr], Om, phi, WH[:nr], WD[:nr])
-        evals += used
-        ic[I_EVALS] += used
+        evals += used - used0
+        ic[I_EVALS] += used - used0
+        if ch == -2:  # budget spent inside the segment: keep the scan's place and report
+            fc[F_TAU] = tau_e
+            ic[I_USED] = used
+            for r in range(nr):
+                held[r] = g[r]
+                held[nrm + r] = dg[r]
+                held[2 * nrm + r] = M[r]
+            ic[I_RESUME] = 1
+            return CHECKPOINT
         te = t + tau_e if ch != -1 else t_end
         if te > t or ch >= 0:
             i = ic[I_NSEG]
@@ -374,12 +407,11 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
             seg_t1[i] = te
             seg_s[i] = s
             seg_k[i] = kp
-            seg_eta[i, :] = eta
-            seg_deta[i, :] = deta
+            copy_into(seg_eta[i], eta)
+            copy_into(seg_deta[i], deta)
             ic[I_NSEG] = i + 1
             state_at(te - t, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, eta, deta)
         fc[F_T] = te
-        ic[I_SKIP] = 0
         if ch >= 0:
             c = rowc[ch]
             if rowk[ch] == ROW_PHASE:
@@ -389,10 +421,6 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
                 alpha_at(AL, te - t, Om, phi, alpha)
                 to_modal(gen[s], G[s], eta, deta, alpha, own_e, own_d)
                 ic[I_PENDING] = c
-        elif ch == -2:
-            ic[I_JUST] = -1
-            ic[I_SKIP] = 1
-            return CHECKPOINT
         else:
             ic[I_JUST] = -1
             if te >= pt1[kp]:

@@ -18,30 +18,28 @@ study over those reuses every mode and transfer matrix.
 
 from __future__ import annotations
 
-import logging
-import os
+import contextlib
+import threading
 import weakref
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
 from ..model.beam import Beam, Contactor
-from ..model.loading import Excitation, time_pieces
+from ..model.loading import Excitation, piece_arrays
 from ..model.starting import InitialCondition, Preload
 from ..modal import mode_set
-from . import _loop
+from . import _codes as _loop, kernels
 from ..model import Damping, SolverOptions
-from .solution import Event, Solution
+from .solution import Solution
 from .blocks import classical_slot, slot_arrays
 from .initial import initial_coordinates
 from .states import StateModel, StateSpace, _preload_key
 
-__all__ = ["integrate", "pack"]
+__all__ = ["integrate", "pack", "pack_key"]
 
-_LOG = logging.getLogger("impactbeam")
-_ANNOUNCED = False
-_BUDGET = 200_000  # evaluations of the closed form between checkpoints (~20-50 ms)
+_BUDGET = 200_000  # scan steps between checkpoints (~20-50 ms compiled; 1,000 interpreted, ~0.1 s)
 _CACHE: OrderedDict[tuple, _Packed] = OrderedDict()
 _CACHE_SIZE = 64
 
@@ -71,21 +69,6 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
     return StateSpace(beam, contactors, damping, excitation, options.modes, points, preload)
 
 
-def kernels_cached() -> bool:
-    """Whether the compiled solver is in numba's disk cache (False: the next run compiles it)."""
-    try:
-        return os.path.exists(_loop.run._cache._cache_file._index_path)
-    except AttributeError:  # pragma: no cover - numba internals changed, or JIT disabled
-        return True
-
-
-def _announce_compile() -> None:
-    """Say once per process that the first run compiles the kernels (about 20 s on 2 cores)."""
-    global _ANNOUNCED
-    if not _ANNOUNCED and not kernels_cached():
-        _LOG.warning("impactbeam: compiling the solver for this machine (first use only, up to a minute on 2 cores); "
-                     "later runs load it from the cache")
-    _ANNOUNCED = True
 
 
 def _grow(a: np.ndarray, n: int) -> np.ndarray:
@@ -214,11 +197,7 @@ def pack(
     preload: Preload | None = None,
 ) -> _Packed:
     """The packed problem, from the cache when its modes and transfers are already known."""
-    key = (
-        beam, tuple((c.position, c.stiffness, c.damping, c.restitution) for c in contactors), damping,
-        excitation.kind, excitation.position, options.modes, options.projection, options.basis,
-        _preload_key(preload),
-    )
+    key = pack_key(beam, contactors, damping, excitation, options, preload)
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
@@ -231,6 +210,23 @@ def pack(
     if len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
     return packed
+
+
+def pack_key(
+    beam: Beam,
+    contactors: tuple[Contactor, ...],
+    damping: Damping,
+    excitation: Excitation,
+    options: SolverOptions,
+    preload: Excitation | None = None,
+) -> tuple:
+    """What a packed problem depends on: not the gaps, sides or the load's time history (cases that differ only
+    in those share their states and transfer matrices, and run in one batch)."""
+    return (
+        beam, tuple((c.position, c.stiffness, c.damping, c.restitution) for c in contactors), damping,
+        excitation.kind, excitation.position, options.modes, options.projection, options.basis,
+        _preload_key(preload),
+    )
 
 
 class _Records:
@@ -262,6 +258,23 @@ class _Records:
                 setattr(self, name, _grow(getattr(self, name), n))
 
 
+_SPARE = threading.local()  # record arrays of this thread's last run, reused by its next one
+
+
+@contextlib.contextmanager
+def _records(nm: int) -> Iterator[_Records]:
+    """Record arrays for a run: this thread's spare ones (grown by earlier runs), or new ones when in use."""
+    rec = getattr(_SPARE, "rec", None)
+    if rec is None or rec.seg_eta.shape[1] != nm:
+        rec = _Records(nm)
+    else:
+        _SPARE.rec = None  # in use (a run started from a callback of this one gets its own)
+    try:
+        yield rec
+    finally:
+        _SPARE.rec = rec
+
+
 _PIECES: weakref.WeakKeyDictionary[Excitation, dict[float, tuple[np.ndarray, ...]]] = weakref.WeakKeyDictionary()
 
 
@@ -269,21 +282,19 @@ def _pieces(excitation: Excitation, end_time: float) -> tuple[np.ndarray, ...]:
     """The load pieces as arrays for the compiled loop, cached per (immutable) excitation and end time."""
     per_end = _PIECES.setdefault(excitation, {})
     if end_time not in per_end:
-        pieces = time_pieces(excitation, end_time)
-        per_end[end_time] = tuple(
-            np.array([getattr(p, f) for p in pieces], dtype=float)
-            for f in ("t0", "t1", "const", "slope", "amp", "Omega", "phase")
-        )
+        per_end[end_time] = piece_arrays(excitation, end_time)
     return per_end[end_time]
 
 
-def _call(pk: _Packed, con: tuple[np.ndarray, ...], pcs: tuple[np.ndarray, ...], opt: SolverOptions, tol_h: float,
-          fc: np.ndarray, ic: np.ndarray, carry: tuple[np.ndarray, ...], rec: _Records) -> int:
+def _call(K: kernels.Kernels, pk: _Packed, con: tuple[np.ndarray, ...], pcs: tuple[np.ndarray, ...],
+          opt: SolverOptions, tol_h: float, fc: np.ndarray, ic: np.ndarray, carry: tuple[np.ndarray, ...],
+          rec: _Records) -> int:
     try:
-        return int(_loop.run(
+        return int(K.run(
             pk.reg, pk.dec, pk.wdh, pk.om, pk.omo, pk.Wc, pk.LW, pk.CW, pk.RW, pk.gen, pk.G, pk.H, pk.smask, pk.Tm,
             pk.tr_from, pk.tr_to, *con, pk.dash, *pcs,
-            float(opt.end_time), tol_h, float(opt.event_tolerance), int(opt.max_events), _BUDGET,
+            float(opt.end_time), tol_h, float(opt.event_tolerance), int(opt.max_events),
+            _BUDGET // 200 if K.interpreted else _BUDGET,
             fc, ic, *carry, rec.seg_t0, rec.seg_t1, rec.seg_s, rec.seg_k, rec.seg_eta, rec.seg_deta,
             rec.ev_t, rec.ev_kind, rec.ev_c, rec.ev_v, rec.ev_d, rec.jumps,
         ))
@@ -329,7 +340,7 @@ def integrate(
         The exact piecewise modal solution with its events.
     """
     contactors = tuple(contactors)
-    _announce_compile()
+    K = kernels.for_work(0)  # interpreted until the run proves long, unless the compiled kernels are loaded
     pk = pack(beam, contactors, damping, excitation, options, preload)
     nm = pk.n_modes
     con = (
@@ -353,13 +364,20 @@ def integrate(
     eta = np.ascontiguousarray(eta, dtype=float)
     deta = np.ascontiguousarray(deta, dtype=float)
     nc1 = max(len(contactors), 1)
-    # slot coordinates, the state in the modal frame at a pending switch, toggles and released phases
-    carry = (eta, deta, eta.copy(), deta.copy(), np.zeros(nc1, dtype=np.int64), np.zeros(nc1, dtype=np.int64))
-    rec = _Records(nm)
+    # slot coordinates, the state in the modal frame at a pending switch, toggles, released phases and the
+    # place of a scan stopped at a checkpoint
+    carry = (eta, deta, eta.copy(), deta.copy(), np.zeros(nc1, dtype=np.int64), np.zeros(nc1, dtype=np.int64),
+             np.zeros(3 * max(2 * len(contactors), 1)))
+    with _records(nm) as rec:
+        return _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress)
+
+
+def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress) -> Solution:
+    """The loop of :func:`integrate` with the arrays it supplies; the solution copied out of ``rec``."""
     while True:
         ic[_loop.I_NSLOTS] = pk.nslots
         ic[_loop.I_NTR] = pk.ntr
-        status = _call(pk, con, pcs, options, tol_h, fc, ic, carry, rec)
+        status = _call(K, pk, con, pcs, options, tol_h, fc, ic, carry, rec)
         if status == _loop.NEED_STATE:
             pk.add_state(int(ic[_loop.REQ_A]))
         elif status == _loop.NEED_TRANSFER:
@@ -368,7 +386,9 @@ def integrate(
             rec.grow(ic)
         elif status == _loop.CHECKPOINT:
             if progress is not None:
-                progress(float(fc[_loop.F_T]))
+                progress(float(fc[_loop.F_T] + (fc[_loop.F_TAU] if ic[_loop.I_RESUME] else 0.0)))
+            if K.interpreted:  # a long run: the compiled kernels (when cached) take over, the same results sooner
+                K = kernels.active()
         else:
             break
     if progress is not None:
@@ -378,37 +398,43 @@ def integrate(
 
 def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solution:
     nseg, nev, njump = int(ic[_loop.I_NSEG]), int(ic[_loop.I_NEV]), int(ic[_loop.I_NJUMP])
-    events = [
-        Event(t, "impact" if k else "rebound", c, v)
-        for t, k, c, v in zip(rec.ev_t[:nev].tolist(), rec.ev_kind[:nev].tolist(), rec.ev_c[:nev].tolist(),
-                              rec.ev_v[:nev].tolist())
-    ]
     t_stop = float(fc[_loop.F_T])
-    if status == _loop.CHATTER:
-        message = (
-            f"Stopped at t = {t_stop:.9g} s after {nev} events (solver.max_events or endless switching at one "
-            "instant): chattering contact; the solution ends there."
-        )
-        code = 1
-    else:
-        message = "The simulation reached end_time."
-        code = 0
+    code = 1 if status == _loop.CHATTER else 0
+    message = stop_message(code, t_stop, nev)
     warnings: list[str] = []
     if ic[_loop.I_WARN_N]:
-        moved, scale = float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE])
-        warnings.append(
-            f"{int(ic[_loop.I_WARN_N])} of {njump} switches: the projection onto {options.modes} modes moved the "
-            f"deflection at a contactor by more than 5 % of its gap or deflection (worst: contactor "
-            f"{int(ic[_loop.I_WARN_C])} by {moved:.3g} m, {100 * moved / scale:.0f} %, at t = "
-            f"{float(fc[_loop.F_WARN_T]):.6g} s): the contactor is too stiff for this number of modes; add modes."
-        )
+        warnings.append(projection_warning(int(ic[_loop.I_WARN_N]), njump, options.modes, int(ic[_loop.I_WARN_C]),
+                                           float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE]),
+                                           float(fc[_loop.F_WARN_T])))
     return Solution(
         t0=rec.seg_t0[:nseg].copy(), t1=rec.seg_t1[:nseg].copy(), slot=rec.seg_s[:nseg].copy(),
         piece=rec.seg_k[:nseg].copy(), eta0=rec.seg_eta[:nseg].copy(), deta0=rec.seg_deta[:nseg].copy(),
-        packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=events,
+        packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=None,
         energy_jumps=rec.jumps[:njump].copy(), event_penetrations=rec.ev_d[:nev].copy(), status=code,
         message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
-        n_modes=pk.n_modes,
+        n_modes=pk.n_modes, event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy(),
+                                          rec.ev_v[:nev].copy()),
     )
 
+
+
+def stop_message(status: int, t_stop: float, n_events: int) -> str:
+    """The solution's message: the end time reached (status 0), or where the chattering guard stopped it (1)."""
+    if status == 1:
+        return (
+            f"Stopped at t = {t_stop:.9g} s after {n_events} events (solver.max_events or endless switching at one "
+            "instant): chattering contact; the solution ends there."
+        )
+    return "The simulation reached end_time."
+
+
+def projection_warning(count: int, switches: int, modes: int, contactor: int, moved: float, scale: float,
+                       when: float) -> str:
+    """The warning of switches whose projection moved a contactor's deflection by more than 5 %."""
+    return (
+        f"{count} of {switches} switches: the projection onto {modes} modes moved the "
+        f"deflection at a contactor by more than 5 % of its gap or deflection (worst: contactor "
+        f"{contactor} by {moved:.3g} m, {100 * moved / scale:.0f} %, at t = "
+        f"{when:.6g} s): the contactor is too stiff for this number of modes; add modes."
+    )

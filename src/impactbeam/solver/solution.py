@@ -10,18 +10,30 @@ use, which the ``solve_ivp`` reference path implements too.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from ..exceptions import ParameterError
-from . import _dense
+from . import kernels
 
 if TYPE_CHECKING:
     from ..model.beam import Contactor
 
 __all__ = ["Event", "Samples", "PiecewiseSolution", "Solution", "ModalState"]
+
+
+_WORK = threading.local()  # work arrays of the metrics, per thread, kernels and size
+
+
+def _work(K: Any, nm: int) -> tuple:
+    key = (id(K), nm)
+    hit = getattr(_WORK, "arrays", None)
+    if hit is None or hit[0] != key:
+        hit = _WORK.arrays = (key, K.dense_work(nm))
+    return hit[1]
 
 
 class Event(NamedTuple):
@@ -284,7 +296,8 @@ class Solution(PiecewiseSolution):
     contactor_arrays : tuple of ndarray
         Positions, stiffnesses, gaps and sides of the contactors.
     contactors : tuple of Contactor
-    events : list of Event
+    events : list of Event or None
+        None: made from ``event_arrays`` when first asked for.
     energy_jumps : ndarray, [J]
         Change of mechanical energy at each switch.
     event_penetrations : ndarray, [m]
@@ -299,11 +312,14 @@ class Solution(PiecewiseSolution):
         Closed-form evaluations the run took.
     n_modes : int
         Coordinates of the state bases.
+    event_arrays : tuple of ndarray, optional
+        The events as arrays: times [s], kinds (1 impact, 0 rebound),
+        contactors and velocities [m/s] (default: from ``events``).
     """
 
     def __init__(self, *, t0, t1, slot, piece, eta0, deta0, packed, pieces, contactor_arrays, contactors,
                  events, energy_jumps, event_penetrations, status, message, warnings, t_end, evaluations,
-                 n_modes) -> None:
+                 n_modes, event_arrays=None) -> None:
         self.t0 = t0
         self.t1 = t1
         self.slot = slot
@@ -314,7 +330,7 @@ class Solution(PiecewiseSolution):
         self.pieces = pieces
         self.contactor_arrays = contactor_arrays
         self.contactors = contactors
-        self.events = events
+        self._events = events
         self.energy_jumps = energy_jumps
         self.event_penetrations = event_penetrations
         self.status = status
@@ -326,6 +342,22 @@ class Solution(PiecewiseSolution):
         self.dashpots = packed.dash
         self._atol = 1e-12 * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
+        self._metric_rows: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        if event_arrays is None:  # times, kinds (1 impact, 0 rebound), contactors, velocities
+            event_arrays = (np.array([e.time for e in events], dtype=float),
+                            np.array([e.kind == "impact" for e in events], dtype=np.int64),
+                            np.array([e.contactor for e in events], dtype=np.int64),
+                            np.array([e.velocity for e in events], dtype=float))
+        self.event_arrays = event_arrays
+
+    @property
+    def events(self) -> list[Event]:  # type: ignore[override]
+        """The events, made from :attr:`event_arrays` on first access."""
+        if self._events is None:
+            t, kind, c, v = self.event_arrays
+            self._events = [Event(ti, "impact" if ki else "rebound", ci, vi)
+                            for ti, ki, ci, vi in zip(t.tolist(), kind.tolist(), c.tolist(), v.tolist())]
+        return self._events
 
     @property
     def n_segments(self) -> int:
@@ -385,7 +417,7 @@ class Solution(PiecewiseSolution):
         en = np.empty((nt, 5)) if energy else np.empty((0, 5))
         if nt and self.n_segments:
             pk = self.packed
-            _dense.sample(t, idx, self.rows(x), w, w_t, eta, eta_t, en, modal, energy,
+            kernels.for_work(nt).sample(t, idx, self.rows(x), w, w_t, eta, eta_t, en, modal, energy,
                           self.t0, self.slot, self.piece, self.eta0, self.deta0, pk.reg, pk.dec, pk.wdh, pk.om,
                           pk.omo, pk.Wc, pk.LW, pk.CW, pk.gen, pk.G, pk.Cd, pk.pw, pk.pre, pk.smask,
                           *self.contactor_arrays, pk.dash, self.pieces[0], *self.pieces[2:])
@@ -399,6 +431,62 @@ class Solution(PiecewiseSolution):
                 if arr is not None:
                     arr[bad] = np.nan
         return Samples(w, w_t, engaged, eta if modal else None, eta_t if modal else None, en if energy else None)
+
+    def metric_arrays(self, x: float, sign: float, table: bool) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+        """The metrics in one compiled call (:func:`~impactbeam.solver._metrics.run_metrics`).
+
+        Parameters
+        ----------
+        x : float, [m]
+            Where ``u = sign w`` is read.
+        sign : float
+            +1 or -1.
+        table : bool
+            Also the per-impact table's peak forces, integrals and end compressions.
+
+        Returns
+        -------
+        scalars : ndarray, (10,)
+            In the order of :data:`~impactbeam.solver._metrics.SCALARS`, NaN where undefined.
+        rows : tuple of ndarray
+            Contactor, start, end, clipped end, peak compression, peak force
+            over stiffness, ``int w dt`` and the compression at both ends
+            (NaN without a dashpot), one entry per contact interval.
+        """
+        K = kernels.for_work(self.n_segments + self.event_arrays[0].size)
+        pk = self.packed
+        ev_t, ev_kind, ev_c = self.event_arrays[:3]
+        nev = ev_t.size
+        n = nev + len(self.contactors) + 1
+        rows = (np.zeros(n, dtype=np.int64), *np.zeros((8, n)))
+        out = np.empty(K.N_SCALARS)
+        Wm, Wc = self.metric_rows(x)
+        pcs = self.pieces
+        n_rows = K.run_metrics(
+            self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, ev_t, ev_kind, ev_c,
+            self.event_penetrations, nev, self.energy_jumps, float(self.t_end), pk.reg, pk.dec, pk.wdh, pk.om, pk.LW,
+            pk.CW, pk.gen, pk.G, pk.smask, *self.contactor_arrays, pk.dash, pcs[0], *pcs[2:], Wm, Wc, float(sign),
+            self._atol, 1e-14, bool(table), out, *rows, _work(K, self.n_modes),
+        )
+        return out, tuple(r[:n_rows] for r in rows)
+
+    def metric_rows(self, x: float) -> tuple[np.ndarray, np.ndarray]:
+        """Shapes at ``x`` (S, n) and at each contactor (n_c, S, n) in every built state slot (cached per position).
+
+        Parameters
+        ----------
+        x : float, [m]
+            The metric point.
+        """
+        hit = self._metric_rows.get(x)
+        if hit is None:
+            Wm = self.rows(np.array([x], dtype=float))[:, 0, :]
+            nc = len(self.contactors)
+            Wc = np.zeros((max(nc, 1),) + Wm.shape)
+            for c, con in enumerate(self.contactors):
+                Wc[c] = self.rows(np.array([con.position], dtype=float))[:, 0, :]
+            hit = self._metric_rows[x] = (np.ascontiguousarray(Wm), Wc)
+        return hit
 
     def _row_table(self, xs: list[float]) -> tuple[np.ndarray, np.ndarray]:
         """Distinct positions of ``xs`` with their shapes in every visited state, and each x's row."""
@@ -417,7 +505,7 @@ class Solution(PiecewiseSolution):
             lo, hi, sign, offset, cond = (np.array(v) for v in zip(*(q[1:6] for q in queries)))
             cond = np.array([-1 if c is None else c for c in cond], dtype=np.int64)
             rate = np.array([q[6] if len(q) > 6 else 0.0 for q in queries], dtype=float)
-            _dense.extremum(
+            kernels.for_work(n * self.n_segments).extremum(
                 lo.astype(float), np.minimum(hi.astype(float), self.t_end), sign.astype(float),
                 offset.astype(float), rate, row, cond, self._atol, 1e-14, Wr, out[0], out[1],
                 self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, *self._model(),
@@ -436,7 +524,7 @@ class Solution(PiecewiseSolution):
             Wr, row = self._row_table([q[0] for q in queries])
             lo = np.array([q[1] for q in queries], dtype=float)
             hi = np.minimum(np.array([q[2] for q in queries], dtype=float), self.t_end)
-            _dense.integral(lo, hi, row, Wr, out, self.t0, self.t1, self.slot, self.piece, self.eta0,
+            kernels.for_work(n * self.n_segments).integral(lo, hi, row, Wr, out, self.t0, self.t1, self.slot, self.piece, self.eta0,
                             self.deta0, *self._model())
         return out
 

@@ -1,11 +1,29 @@
-"""Batches of cases: the chunks of the store, and running one batch in a worker."""
+"""Batches of cases: the chunks of the store, and running one batch in a worker.
+
+A batch's cases run through :func:`impactbeam.simulation.run_cases`: those
+that share their packed problem (the usual case: a batch holds one geometry)
+run in one compiled call, metrics included. Building a case is cheap too:
+the paths in :data:`_DIRECT` (gaps, sides, the load's amplitude, duration,
+start, frequency, phase and scale, the run's end time, output step, event
+tolerance and event limit) change no packed problem and are set on the model
+objects of a scenario parsed once per value of the other paths; each of
+their values is read by the scenario parser itself (one parse of that value
+alone, so units, checks and messages are the parser's), which gives the
+same model objects as re-parsing every case (a test compares them). A case
+the direct route cannot build (an invalid value, or a value the model
+objects refuse in combination) is parsed whole, as before, so its error
+message is the same. Sampled designs, whose values are all distinct, parse
+every case whole.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+import re
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from itertools import product
 from typing import Any
@@ -134,6 +152,127 @@ def _statistics_arrays(base: Any, n: int) -> dict[str, np.ndarray]:
             for name, (dim, _, _) in record_variables(base).items()}
 
 
+#: Paths set directly on the model objects (module docstring): section, index, field.
+_DIRECT = re.compile(
+    r"^(?:(contactors)\.(\d+)\.(gap|side)|(excitation)\.(amplitude|duration|start|frequency|phase|scale)"
+    r"|(solver)\.(end_time|time_step|event_tolerance|max_events))$"
+)
+
+
+class _CaseBuilder:
+    """The cases of a sweep as :class:`~impactbeam.simulation.Case` objects (module docstring).
+
+    One per worker process and sweep (:func:`_builder`): the scenarios of
+    the other paths' values, the direct values as the parser reads them and
+    the model objects made from them are kept, so a grid's batches reuse
+    them (and the load pieces cached on an excitation object).
+    """
+
+    def __init__(self, base: Any, paths: Sequence[str]) -> None:
+        self.base = base
+        self.paths = tuple(paths)
+        self.direct = [i for i, p in enumerate(paths) if _DIRECT.match(p)]
+        self.other = [i for i in range(len(paths)) if i not in self.direct]
+        self._groups: dict[str, Any] = {}
+        self._fields: dict[tuple[str, int, str], Any] = {}
+        self._objects: dict[tuple, Any] = {}
+        self._known: set[tuple[int, str]] = set()  # direct values read already (for some group)
+
+    def cases(self, values: Sequence[Sequence[Any]]) -> list[Any]:
+        """The cases of a batch (a Case each, or the exception its scenario raises)."""
+        fresh = {(i, repr(v[i])) for v in values for i in self.direct} - self._known
+        # a parse per new value against one per case: a grid's values recur (and are kept for the next
+        # batches), a sampled design's are all new, several per case
+        whole = len(fresh) > 1.5 * len(values)
+        return [self._whole(vals) if whole else self._direct(vals) or self._whole(vals) for vals in values]
+
+    def _whole(self, vals: Sequence[Any]) -> Any:
+        """The case from the scenario re-parsed with all its values (or the exception)."""
+        from ..simulation import Case
+
+        try:
+            sc = self.base.with_values(dict(zip(self.paths, vals)))
+        except Exception as exc:  # recorded for this case
+            return exc
+        return Case(sc.beam, sc.contactors, sc.damping, sc.excitation, sc.initial, sc.solver, sc.output_points,
+                    sc.preload)
+
+    def _direct(self, vals: Sequence[Any]) -> Any:
+        """The case built from the group's scenario and the direct values, or None (parse it whole)."""
+        from ..simulation import Case
+
+        gkey = repr([vals[i] for i in self.other])
+        group = self._groups.get(gkey)
+        if group is None:
+            try:
+                group = self.base.with_values({self.paths[i]: vals[i] for i in self.other})
+            except Exception as exc:
+                group = exc
+            self._groups[gkey] = group
+        if isinstance(group, Exception):
+            return None
+        changes: dict[str, list[tuple[Any, ...]]] = {"contactors": [], "excitation": [], "solver": []}
+        for i in self.direct:
+            value = self._field(gkey, group, i, vals[i])
+            if isinstance(value, Exception):
+                return None
+            section, *rest = self.paths[i].split(".")
+            changes[section].append((*rest, value) if section == "contactors" else (rest[-1], value))
+        try:
+            contactors = self._made("contactors", gkey, changes["contactors"], group)
+            ex = self._made("excitation", gkey, changes["excitation"], group)
+            solver = self._made("solver", gkey, changes["solver"], group)
+        except Exception:
+            return None
+        return Case(group.beam, contactors, group.damping, ex, group.initial, solver, group.output_points,
+                    group.preload)
+
+    def _made(self, section: str, gkey: str, changes: list[tuple[Any, ...]], group: Any) -> Any:
+        """The group's contactors, excitation or solver options with ``changes`` made (one object per change set)."""
+        if not changes:
+            return getattr(group, section)
+        key = (section, gkey, repr(changes))
+        if key not in self._objects:
+            if section == "contactors":
+                con = list(group.contactors)
+                for index, name, value in changes:
+                    con[int(index)] = dataclasses.replace(con[int(index)], **{name: value})
+                self._objects[key] = tuple(con)
+            else:
+                self._objects[key] = dataclasses.replace(getattr(group, section), **dict(changes))
+        return self._objects[key]
+
+    def _field(self, gkey: str, group: Any, i: int, value: Any) -> Any:
+        """The model value of direct path ``i`` set to ``value``, as the parser reads it (or its exception)."""
+        key = (gkey, i, repr(value))
+        if key not in self._fields:
+            path = self.paths[i]
+            try:
+                sc = group.with_values({path: value})
+                section, *rest = path.split(".")
+                obj = sc.contactors[int(rest[0])] if section == "contactors" else getattr(sc, section)
+                self._fields[key] = getattr(obj, rest[-1])
+            except Exception as exc:
+                self._fields[key] = exc
+            self._known.add((i, key[2]))
+        return self._fields[key]
+
+
+_BUILDERS: dict[str, _CaseBuilder] = {}
+
+
+def _builder(batch: _Batch) -> _CaseBuilder:
+    """The case builder of this batch's sweep in this process (kept for its next batches)."""
+    key = repr((batch.base_data, batch.base_dir, batch.source, batch.name, batch.paths))
+    b = _BUILDERS.get(key)
+    if b is None:
+        base = parse_scenario(batch.base_data, base_dir=batch.base_dir, source=batch.source, name=batch.name)
+        b = _BUILDERS[key] = _CaseBuilder(base, batch.paths)
+        while len(_BUILDERS) > 4:
+            _BUILDERS.pop(next(iter(_BUILDERS)))
+    return b
+
+
 def run_batch(batch: _Batch) -> dict[str, Any]:
     """Run the cases of one batch (on a worker); per-case errors are recorded.
 
@@ -146,16 +285,48 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     batch : _Batch
         The cases of one chunk of the store.
     """
-    from ..simulation import simulate
+    from ..result.metrics import METRIC_UNITS
+    from ..simulation import run_cases
 
     _tune_malloc()
     n = len(batch.values)
     out: dict[str, Any] = {m: np.full(n, np.nan) for m in batch.metrics}
     status = np.full(n, FAILED, dtype=np.int8)
     message = [""] * n
+    builder = _builder(batch)
+    whole = batch.history_times is not None or batch.statistics or not set(batch.metrics) <= set(METRIC_UNITS)
+    if whole:  # histories, statistics and the stress metrics need each case's whole result
+        return _run_one_by_one(batch, builder.base, out, status, message)
+    built = builder.cases(batch.values)
+    ok = [k for k, c in enumerate(built) if not isinstance(c, Exception)]
+    res = run_cases([built[k] for k in ok])
+    columns = [list(METRIC_UNITS).index(m) for m in batch.metrics]
+    row = {k: j for j, k in enumerate(ok)}
+    for k, c in enumerate(built):
+        err = c if isinstance(c, Exception) else res.errors[row[k]]
+        if err is not None:  # the first failing case, in case order, when errors stop the sweep
+            if batch.on_error == "raise":
+                raise err
+            message[k] = _error_message(err)
+            continue
+        j = row[k]
+        for m, col in zip(batch.metrics, columns):
+            out[m][k] = res.scalars[j, col]
+        status[k] = res.status[j]
+        message[k] = "" if res.status[j] == 0 else " ".join(str(res.messages[j]).split())
+    out["status"] = status
+    out["message"] = message
+    return out
+
+
+def _run_one_by_one(batch: _Batch, base: Any, out: dict[str, Any], status: np.ndarray, message: list[str]
+                    ) -> dict[str, Any]:
+    """The cases with histories or statistics: each simulated alone (its deflection sampled at the history times)."""
+    from ..simulation import simulate
+
     ht = batch.history_times
+    n = len(batch.values)
     w = None if ht is None else np.full((n, ht.size, len(batch.history_points)), np.nan)
-    base = parse_scenario(batch.base_data, base_dir=batch.base_dir, source=batch.source, name=batch.name)
     stats = _statistics_arrays(base, n) if batch.statistics else {}
     for k, vals in enumerate(batch.values):
         try:

@@ -115,7 +115,12 @@ class _Critical:
 
 
 class _Writer:
-    """Writes finished batches into the store's chunks (status last)."""
+    """Writes finished batches into the store's chunks (status last).
+
+    A batch's arrays are written by a few threads at once (each write is a
+    round trip through Zarr's event loop, most of it waiting), then its
+    status: an interrupted write leaves the batch "not yet run".
+    """
 
     def __init__(self, store: Any, spec: SweepSpec) -> None:
         zarr = require("zarr", "sweep")
@@ -124,19 +129,30 @@ class _Writer:
         self.arrays = {name: self.group[name] for name in (*spec.metrics, *statistic_names(spec), "message", "status")}
         if spec.histories is not None:
             self.arrays["w"] = self.group["w"]
+        self._threads: Any = None
 
     def write(self, region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
         sl = tuple(slice(a, b) for a, b in region)
         shape = tuple(b - a for a, b in region)
+        jobs = []
         for name, arr in self.arrays.items():
             if name == "status":
                 continue
             value = res[name]
             if name == "message":
                 value = np.array(value, dtype=np.dtypes.StringDType())
-            value = np.asarray(value).reshape(shape + np.shape(value)[1:])
-            arr[sl] = value
+            jobs.append((arr, np.asarray(value).reshape(shape + np.shape(value)[1:])))
+        if self._threads is None:
+            from concurrent.futures import ThreadPoolExecutor
+
+            self._threads = ThreadPoolExecutor(4, thread_name_prefix="impactbeam-zarr")
+        for f in [self._threads.submit(arr.__setitem__, sl, value) for arr, value in jobs]:
+            f.result()
         self.arrays["status"][sl] = np.asarray(res["status"], dtype=np.int8).reshape(shape)
+
+    def close(self) -> None:
+        if self._threads is not None:
+            self._threads.shutdown()
 
     def status(self) -> np.ndarray:
         return self.arrays["status"][...]
@@ -161,7 +177,7 @@ def run_sweep(
     out : str or path-like, optional
         Zarr store to create or resume (None: in memory).
     workers : int, optional
-        Processes of a local Dask cluster (0: in this process).
+        Worker processes on this machine (0: in this process).
     scheduler : str, optional
         Address of a running Dask scheduler.
     batch_size : int, optional
@@ -225,37 +241,48 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
     """:func:`run_sweep` once the store is ours."""
     fresh = not (out_path is not None and out_path.exists()
                  and not (out_path.is_dir() and not any(out_path.iterdir())))
-    store = _create_store(spec, out_path, chunk) if fresh else _open_existing(spec, out_path)  # type: ignore[arg-type]
-    writer = _Writer(store, spec)
-    chunk = tuple(writer.arrays["status"].chunks)  # the store's layout wins on resume
-    # a new store has run nothing: no need to read its (possibly millions of) status chunks
-    status = np.full(spec.shape, NOT_RUN, dtype=np.int8) if fresh else writer.status()
-    regions = (r for r in _regions(spec.shape, chunk) if (status[r] == NOT_RUN).any())  # lazily
-    skipped = int((status != NOT_RUN).sum())
-    n_todo = spec.n_cases - skipped
+    local = None
     counts = {"computed": 0, "failed": 0}
-
-    from tqdm.auto import tqdm
-
-    bar = tqdm(total=spec.n_cases, initial=spec.n_cases - n_todo, desc="sweep", unit="case",
-               file=sys.stderr, disable=not progress, dynamic_ncols=True)
-
-    def done(region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
-        with guard.write():
-            writer.write(region, res)
-        n = len(res["status"])
-        counts["computed"] += n
-        counts["failed"] += int((np.asarray(res["status"]) == FAILED).sum())
-        bar.update(n)
-
+    bar = writer = None
     try:
         with _SignalGuard() as guard:
+            if fresh and workers != 0 and scheduler is None:
+                # a new store runs every batch of this layout: the workers start on them while it is made
+                local = _LocalWorkers(workers or os.cpu_count() or 1)
+                local.start(_make_batch(spec, r, on_error) for r in _regions(spec.shape, chunk))
+            store = _create_store(spec, out_path, chunk) if fresh else _open_existing(spec, out_path)  # type: ignore[arg-type]
+            writer = _Writer(store, spec)
+            chunk = tuple(writer.arrays["status"].chunks)  # the store's layout wins on resume
+            # a new store has run nothing: no need to read its (possibly millions of) status chunks
+            status = np.full(spec.shape, NOT_RUN, dtype=np.int8) if fresh else writer.status()
+            regions = (r for r in _regions(spec.shape, chunk) if (status[r] == NOT_RUN).any())  # lazily
+            skipped = int((status != NOT_RUN).sum())
+            n_todo = spec.n_cases - skipped
+
+            from tqdm.auto import tqdm
+
+            bar = tqdm(total=spec.n_cases, initial=spec.n_cases - n_todo, desc="sweep", unit="case",
+                       file=sys.stderr, disable=not progress, dynamic_ncols=True)
+
+            def done(region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
+                with guard.write():
+                    writer.write(region, res)  # type: ignore[union-attr]
+                n = len(res["status"])
+                counts["computed"] += n
+                counts["failed"] += int((np.asarray(res["status"]) == FAILED).sum())
+                bar.update(n)  # type: ignore[union-attr]
+
             if n_todo:
                 batches = (_make_batch(spec, r, on_error) for r in regions)
                 try:
                     if workers == 0:
                         for b in batches:
                             done(b.region, run_batch(b))
+                    elif scheduler is None:
+                        if local is None:
+                            local = _LocalWorkers(workers or os.cpu_count() or 1)
+                            local.start(batches)
+                        local.finish(done)
                     else:
                         _run_dask(batches, done, workers=workers, scheduler=scheduler, on_error=on_error)
                 except SweepInterrupted as exc:
@@ -263,7 +290,12 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
                     exc.total = spec.n_cases
                     raise
     finally:
-        bar.close()
+        if local is not None:
+            local.close()
+        if bar is not None:
+            bar.close()
+        if writer is not None:
+            writer.close()
     log.info("sweep %s: %d cases, %d computed, %d already done, %d failed",
              spec.name, spec.n_cases, counts["computed"], skipped, counts["failed"])
     import xarray as xr
@@ -284,6 +316,88 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
     if out_path is None:
         ds = ds.load()
     return SweepRun(ds, spec.n_cases, counts["computed"], skipped, counts["failed"], out_path)
+
+
+def _worker_start() -> None:
+    """A local worker leaves SIGINT to the sweep's process (which stops it) and uses one BLAS thread."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[var] = "1"
+
+
+class _LocalWorkers:
+    """``workers`` processes on this machine running batches (:func:`run_batch`), a bounded window at a time.
+
+    The processes are forked from this one where the platform allows it
+    (Linux: they start at once, with the solver already loaded; the fork
+    comes before Zarr starts its event-loop thread), elsewhere spawned. A
+    window of batches is in flight (64, or 4 per worker if more: enough to
+    keep the workers busy while a new store is being made), so a sweep of any
+    size starts at once and an interrupt has only a few to drop; :meth:`close`
+    terminates the processes (after an interrupt or an error too). A case's
+    error reaches here only with ``on_error = "raise"``, and is raised again.
+    """
+
+    def __init__(self, workers: int) -> None:
+        import queue
+
+        self.workers = workers
+        self.finished: queue.Queue[tuple[Any, Any, BaseException | None]] = queue.Queue()
+        self.window = max(64, 4 * workers)
+        self.pool: Any = None
+        self.in_flight = 0
+        self.pending: Iterator[_Batch] = iter(())
+
+    def start(self, batches: Iterator[_Batch]) -> None:
+        """Run the first batch here, then start the workers on the first window of the rest.
+
+        The first batch loads (or compiles, on first use) the solver and
+        builds the problem's states; forked workers inherit all of it instead
+        of doing it once each.
+        """
+        import multiprocessing as mp
+
+        self.pending = iter(batches)
+        first = next(self.pending, None)
+        if first is not None:
+            try:
+                self.finished.put((first.region, run_batch(first), None))
+            except Exception as exc:
+                self.finished.put((first.region, None, exc))
+            self.in_flight += 1
+        fork = sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods()
+        ctx = mp.get_context("fork" if fork else "spawn")
+        self.pool = ctx.Pool(self.workers, initializer=_worker_start)
+        while self.in_flight < self.window and self._submit():
+            pass
+
+    def _submit(self) -> bool:
+        b = next(self.pending, None)
+        if b is None:
+            return False
+        put = self.finished.put
+        self.pool.apply_async(run_batch, (b,), callback=lambda r, region=b.region: put((region, r, None)),
+                              error_callback=lambda e, region=b.region: put((region, None, e)))
+        self.in_flight += 1
+        return True
+
+    def finish(self, done: Any) -> None:
+        """``done(region, result)`` for every batch, in the order they finish."""
+        while self.in_flight:
+            region, res, err = self.finished.get()
+            self.in_flight -= 1
+            if err is not None:
+                raise err
+            done(region, res)
+            self._submit()
+        if self.pool is not None:
+            self.pool.close()
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.terminate()
+            self.pool.join()
 
 
 def _run_dask(
@@ -365,9 +479,9 @@ def sweep(
         only the missing cases run (resume). Without ``out`` the results are
         kept in memory.
     workers : int, optional
-        Worker processes of a local ``dask.distributed`` cluster (one thread
-        each); default all cores. ``0`` runs the cases in this process,
-        without Dask.
+        Worker processes on this machine (forked from this one on Linux,
+        spawned elsewhere); default all cores. ``0`` runs the cases in this
+        process.
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``) whose
         workers run the cases (they need ``impactbeam`` installed and the

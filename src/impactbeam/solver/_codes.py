@@ -1,0 +1,25 @@
+"""The compiled loop's status codes and the layout of its carried state (no numba here).
+
+:mod:`~impactbeam.solver._loop` returns a status code and keeps everything
+it carries from one call to the next in two arrays, ``ic`` (integers) and
+``fc`` (floats), at these indices; the Python side
+(:mod:`~impactbeam.solver.engine`, :mod:`~impactbeam.solver.batch`) reads
+them from here, so that importing it does not import numba.
+"""
+
+from __future__ import annotations
+
+__all__ = ["DONE", "CHATTER", "NEED_STATE", "NEED_TRANSFER", "NEED_SPACE", "CHECKPOINT", "CASE_DONE",
+           "I_SLOT", "I_PIECE", "I_JUST", "I_PENDING", "I_NSEG", "I_NEV", "I_NJUMP", "I_NSLOTS", "I_NTR",
+           "I_WARN_C", "REQ_A", "REQ_B", "I_RESUME", "I_EVALS", "I_SAME", "I_WARN_N", "I_USED", "N_INT",
+           "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "N_FLOAT"]
+
+DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
+CASE_DONE = 6  # a batch finished a case and stops after each (a continuation)
+# integer carry
+I_SLOT, I_PIECE, I_JUST, I_PENDING, I_NSEG, I_NEV, I_NJUMP, I_NSLOTS, I_NTR = 0, 1, 2, 3, 4, 5, 6, 7, 8
+I_WARN_C, REQ_A, REQ_B, I_RESUME, I_EVALS, I_SAME, I_WARN_N, I_USED = 9, 10, 11, 12, 13, 14, 15, 16
+N_INT = 17
+# float carry
+F_T, F_LAST_T, F_WARN_T, F_WARN_MOVED, F_WARN_SCALE, F_TAU = 0, 1, 2, 3, 4, 5
+N_FLOAT = 6

@@ -1,0 +1,220 @@
+"""Batched runs, interpreted kernels and resumable scans give the bits of a single compiled run (issue 24).
+
+Every check here is bit-for-bit, with no tolerance: the paths compared run
+the same arithmetic in the same order (one BLAS thread), so any difference
+is a bug, not round-off.
+
+* a case run in a batch (:func:`impactbeam.simulation.run_cases`, the path of
+  sweeps) against ``simulate_system(...).metrics(impacts=False)`` alone;
+* the interpreted twins of the kernels (the first-use path) against the
+  compiled ones: segment records, events, samples, extrema and the metrics
+  with the per-impact table, on every code path (the paper's basis, the
+  shared basis, dashpots and free-mode damping in general states, rigid-body
+  modes, a harmonic load, a chattering stop);
+* a run returning to Python every few scan steps against one that never does;
+* the compiled pairwise sum against NumPy's ``sum``;
+* the sweep's case builder against re-parsing the scenario.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impactbeam as ib
+from impactbeam.model import Damping, SolverOptions
+from impactbeam.model.beam import Contactor, Support
+from impactbeam.model.loading import Excitation
+from impactbeam.model.starting import InitialCondition, Preload
+from impactbeam.result.metrics import METRIC_UNITS
+from impactbeam.simulation import Case, run_cases
+from impactbeam.solver import engine, kernels
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _case3() -> ib.Scenario:
+    return ib.load_scenario(EXAMPLES / "case03.toml")
+
+
+def _same(a: float | None, b: float) -> bool:
+    return bool(np.isnan(b)) if a is None else a == b
+
+
+def _variants() -> dict[str, Case]:
+    """Cases covering the engine's paths, each short."""
+    sc = _case3()
+    rep = dataclasses.replace
+    c0 = sc.contactors[0]
+    L = sc.beam.length
+    short = rep(sc.solver, end_time=0.06)
+
+    def case(**kw) -> Case:
+        base = dict(beam=sc.beam, contactors=sc.contactors, damping=sc.damping, excitation=sc.excitation,
+                    initial=sc.initial, options=short, points=sc.output_points)
+        base.update(kw)
+        return Case(**base)
+
+    free_free = rep(sc.beam, left=Support.preset("free"), right=Support.preset("free"))
+    return {
+        "case3": case(),
+        "zero_gap_below": case(contactors=(rep(c0, gap=0.0, side="below"),)),
+        "paper_basis": case(options=rep(short, basis="paper")),
+        "two_stops_dashpot": case(contactors=(rep(c0, damping=0.3), rep(c0, position=L, side="below", gap=3e-4))),
+        "free_modes_damping": case(damping=Damping(0.011, 0.0, "free_modes")),
+        "chattering": case(options=rep(short, max_events=5)),
+        "no_contactor": case(contactors=(), points=(L,)),
+        "rigid_modes": case(beam=free_free, contactors=(rep(c0, position=0.1 * L, side="below"),),
+                            excitation=Excitation(kind="point_force", shape="half_sine", amplitude=-0.05,
+                                                  duration=0.004, position=0.3 * L), points=(0.1 * L,)),
+        "harmonic": case(excitation=Excitation(kind="base_acceleration", shape="harmonic", amplitude=30.0,
+                                               frequency=70.0), options=rep(short, end_time=0.1)),
+        "rayleigh": case(damping=Damping(model="rayleigh", alpha=2.0, beta=2e-5)),
+        "initial_velocity": case(initial=InitialCondition(velocity=-0.05)),
+        # the equilibrium under gravity depends on the gap: engaged at zero gap, free at 0.1 mm (per case)
+        "preload_engaged": case(contactors=(rep(c0, gap=0.0, side="below"),), preload=Preload("gravity", -9.81),
+                                initial=InitialCondition(equilibrium=True)),
+        "preload_free": case(contactors=(rep(c0, gap=1e-4, side="below"),), preload=Preload("gravity", -9.81),
+                             initial=InitialCondition(equilibrium=True)),
+    }
+
+
+def _alone(c: Case) -> ib.SimulationResult:
+    return ib.simulate_system(c.beam, c.contactors, damping=c.damping, excitation=c.excitation, initial=c.initial,
+                              options=c.options, points=c.points, preload=c.preload)
+
+
+@pytest.mark.filterwarnings("ignore:initial.velocity")  # a uniform velocity of a cantilever: the clamp holds part
+def test_a_case_gives_the_same_bits_alone_or_in_a_batch():
+    cases = _variants()
+    names = list(cases)
+    # every case twice, and Case 3 with other gaps and loads in the same batch as Case 3
+    sc = _case3()
+    extra = [dataclasses.replace(cases["case3"], contactors=(dataclasses.replace(sc.contactors[0], gap=g),),
+                                 excitation=dataclasses.replace(sc.excitation, amplitude=a))
+             for g, a in ((1e-4, 100.0), (4e-4, 180.0), (0.0, 60.0))]
+    batch = [cases[n] for n in names] + extra + [cases[n] for n in names]
+    res = run_cases(batch)
+    assert all(e is None for e in res.errors), res.messages
+    for k, c in enumerate(batch):
+        alone = _alone(c)
+        m = alone.metrics(impacts=False)
+        for j, key in enumerate(METRIC_UNITS):
+            assert _same(m[key], res.scalars[k, j]), (k, key, m[key], res.scalars[k, j])
+        assert res.status[k] == alone.status
+        assert res.messages[k] == alone.message
+    assert res.status[names.index("chattering")] == 1
+
+
+def test_a_failing_case_fails_alone_in_its_batch():
+    sc = _case3()
+    good = Case(sc.beam, sc.contactors, sc.damping, sc.excitation, sc.initial,
+                dataclasses.replace(sc.solver, end_time=0.02), sc.output_points)
+    off_beam = dataclasses.replace(good, contactors=(dataclasses.replace(sc.contactors[0], position=0.2),))
+    res = run_cases([good, off_beam, good])
+    assert res.status.tolist() == [0, -1, 0]
+    assert "contactors.0" in res.messages[1] and isinstance(res.errors[1], ib.ParameterError)
+    np.testing.assert_array_equal(res.scalars[0], res.scalars[2])
+
+
+def _records(sol) -> list[np.ndarray]:
+    return [sol.t0, sol.t1, sol.slot, sol.piece, sol.eta0, sol.deta0, *sol.event_arrays, sol.energy_jumps,
+            sol.event_penetrations]
+
+
+@pytest.mark.parametrize("name", ["case3", "paper_basis", "two_stops_dashpot", "free_modes_damping", "rigid_modes",
+                                  "harmonic", "chattering", "no_contactor"])
+def test_interpreted_kernels_give_the_compiled_bits(name):
+    c = _variants()[name]
+    out = {}
+    for kind in ("compiled", "interpreted"):
+        with kernels.forced(kind):
+            res = _alone(c)
+            x = np.array(sorted({*c.points, c.beam.length}))
+            t = np.linspace(0.0, c.options.end_time, 23)
+            smp = res.solution.sample(x, t, modal=True, energy=True)
+            ext = res.solution.extrema([(x[0], 0.0, c.options.end_time, 1.0, 0.0, None),
+                                        (x[-1], 0.01, 0.03, -1.0, 0.0, None)])
+            ints = res.solution.integrals([(x[0], 0.0, c.options.end_time)])
+            out[kind] = (_records(res.solution), res.metrics(), [smp.w, smp.w_t, smp.eta, smp.energies], ext, ints)
+    a, b = out["compiled"], out["interpreted"]
+    for u, v in zip(a[0] + a[2] + [a[3], a[4]], b[0] + b[2] + [b[3], b[4]]):
+        np.testing.assert_array_equal(u, v)
+    assert a[1] == b[1]  # every metric and the per-impact table, to the bit
+
+
+def test_the_solution_does_not_depend_on_where_the_run_returns_to_python(monkeypatch):
+    """A scan stopped every 3 steps resumes where it was: the same segments as an uninterrupted run."""
+    sc = _case3()
+    plain = ib.simulate(sc).solution
+    seen = []
+    monkeypatch.setattr(engine, "_BUDGET", 3)
+    cut = ib.simulate_system(sc.beam, sc.contactors, damping=sc.damping, excitation=sc.excitation,
+                             options=sc.solver, progress=seen.append).solution
+    assert len(seen) > 50  # it did return often
+    assert np.all(np.diff(seen) >= 0.0)  # progress moves forward, also inside a segment
+    for u, v in zip(_records(plain), _records(cut)):
+        np.testing.assert_array_equal(u, v)
+
+
+@pytest.mark.parametrize("kind", ["compiled", "interpreted"])
+def test_pairwise_sum_is_numpy_sum(kind):
+    K = kernels.compiled() if kind == "compiled" else kernels.interpreted()
+    rng = np.random.default_rng(24)
+    for n in [*range(0, 40), 127, 128, 129, 255, 256, 257, 300, 1000, 1031]:
+        x = rng.standard_normal(n) * 10.0 ** rng.integers(-12, 3, n)
+        assert K.pairwise_sum(x, n) == np.sum(x), n
+    zero = np.array([-0.0])
+    assert np.signbit(K.pairwise_sum(zero, 1)) == np.signbit(np.sum(zero))  # +0.0, as NumPy adds to 0.0
+
+
+def test_case_builder_gives_the_model_objects_of_a_reparse():
+    """Direct paths set on the model objects equal a full re-parse of the scenario, field by field."""
+    from impactbeam.sweeps.batches import _CaseBuilder
+
+    sc = _case3()
+    paths = ("contactors.0.stiffness", "contactors.0.gap", "contactors.0.side", "excitation.amplitude",
+             "excitation.duration", "excitation.start", "excitation.scale", "solver.end_time",
+             "solver.event_tolerance", "solver.max_events", "solver.time_step")
+    rng = np.random.default_rng(7)
+    values = [[float(rng.choice([4030.0, 5000.0])), float(rng.choice([0.0, 1e-4, 2.29e-4])),
+               str(rng.choice(["above", "below"])), float(rng.choice([50.0, 147.1])), float(rng.choice([5e-3, 0.015])),
+               float(rng.choice([0.0, 1e-3])), float(rng.choice([0.5, 1.0])), float(rng.choice([0.05, 0.2])),
+               float(rng.choice([1e-13, 1e-12])), int(rng.choice([100, 10_000])), float(rng.choice([1e-5, 1e-4]))]
+              for _ in range(40)]
+    values.append([4030.0, -1e-4, "above", 50.0, 0.015, 0.0, 1.0, 0.2, 1e-13, 100, 1e-5])  # a negative gap
+    built = _CaseBuilder(sc, paths).cases(values)
+    for vals, case in zip(values, built):
+        try:
+            ref = sc.with_values(dict(zip(paths, vals)))
+        except ib.ScenarioError as exc:
+            assert isinstance(case, ib.ScenarioError) and str(case) == str(exc)
+            continue
+        assert case.beam == ref.beam and case.contactors == ref.contactors and case.damping == ref.damping
+        assert case.options == ref.solver and case.points == ref.output_points
+        for f in dataclasses.fields(Excitation):
+            u, v = getattr(case.excitation, f.name), getattr(ref.excitation, f.name)
+            assert (u is None and v is None) or np.array_equal(u, v), f.name
+        assert dataclasses.astuple(case.initial) == dataclasses.astuple(ref.initial)
+
+
+def test_first_use_runs_interpreted_and_compiles_in_the_background(monkeypatch):
+    """With an empty cache a run does not wait for numba: interpreted kernels, one background compile.
+
+    And before the compiled kernels are loaded, small work runs interpreted without asking for them.
+    """
+    started = []
+    monkeypatch.setattr(kernels, "_READY", False)
+    monkeypatch.setattr(kernels, "_LOADED", False)
+    monkeypatch.setattr(kernels, "_CHECKED", -1e9)
+    monkeypatch.setattr(kernels, "_SPENT", 0.0)
+    monkeypatch.setattr(kernels, "ready", lambda: False)
+    monkeypatch.setattr(kernels, "_compile_in_background", lambda: started.append(1))
+    assert kernels.for_work(10).interpreted and started == []  # small: not even a look at the cache
+    assert kernels.active().interpreted and started == [1]
+    sc = _case3()
+    res = ib.simulate(dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time=0.03)))
+    assert res.metrics()["n_impacts"] == 1
