@@ -52,7 +52,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
-import scipy.optimize
 
 from ..exceptions import ParameterError
 from ..modal import static_state
@@ -171,6 +170,8 @@ def _lcp(flex: np.ndarray, d0: np.ndarray, k: np.ndarray) -> np.ndarray:
     M = 0.5 * (flex + flex.T) + np.diag(1.0 / k)
     R = scipy.linalg.cholesky(M, lower=False)
     rhs = scipy.linalg.solve_triangular(R, d0, trans="T")
+    import scipy.optimize  # here: importing it costs ~0.15 s, and few runs start from an equilibrium
+
     lam, _ = scipy.optimize.nnls(R, rhs, maxiter=50 * d0.size + 100)
     return lam
 
