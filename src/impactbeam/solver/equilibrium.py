@@ -170,9 +170,9 @@ def _lcp(flex: np.ndarray, d0: np.ndarray, k: np.ndarray) -> np.ndarray:
     M = 0.5 * (flex + flex.T) + np.diag(1.0 / k)
     R = scipy.linalg.cholesky(M, lower=False)
     rhs = scipy.linalg.solve_triangular(R, d0, trans="T")
-    import scipy.optimize  # here: importing it costs ~0.15 s, and few runs start from an equilibrium
+    from scipy.optimize import nnls  # here: importing it costs ~0.15 s, and few runs start from an equilibrium
 
-    lam, _ = scipy.optimize.nnls(R, rhs, maxiter=50 * d0.size + 100)
+    lam, _ = nnls(R, rhs, maxiter=50 * d0.size + 100)
     return lam
 
 
