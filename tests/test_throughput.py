@@ -218,3 +218,29 @@ def test_first_use_runs_interpreted_and_compiles_in_the_background(monkeypatch):
     sc = _case3()
     res = ib.simulate(dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time=0.03)))
     assert res.metrics()["n_impacts"] == 1
+
+
+def test_batches_hold_a_bounded_memory_of_load_pieces(monkeypatch):
+    # A batch pads every case's load pieces to the longest: 90 random loads of 100 s (800,000 samples each)
+    # would hold ~5 GB at once. run_cases cuts a group into batches of at most BATCH_BYTES of pieces, and
+    # a case gives the same bits in any of them.
+    import impactbeam.simulation as simulation
+    import impactbeam.solver.batch as batch_module
+
+    sc = _case3().with_values({
+        "excitation.shape": "random", "excitation.amplitude": None, "excitation.duration": None,
+        "excitation.psd": [["10 Hz", "0.01 g^2/Hz"], ["500 Hz", "0.01 g^2/Hz"]], "solver.end_time": 0.07,
+    })
+    cases = [Case(s.beam, s.contactors, s.damping, s.excitation, s.initial, s.solver, s.output_points)
+             for s in (sc.with_values({"excitation.seed": seed}) for seed in (1, 2, 3, 4, 5))]
+    per_case = simulation.case_bytes(cases[0])
+    assert per_case > 72 * cases[0].excitation.times.size  # the samples, their pieces and a margin
+    monkeypatch.setattr(simulation, "BATCH_BYTES", 2 * per_case)
+    sizes = []
+    real = batch_module.integrate_batch
+    monkeypatch.setattr(batch_module, "integrate_batch", lambda *a, **k: (sizes.append(len(a[1])), real(*a, **k))[1])
+    res = run_cases(cases)
+    assert sizes == [2, 2, 1]
+    for k, c in enumerate(cases):
+        m = _alone(c).metrics(impacts=False)
+        assert all(_same(m[key], res.scalars[k, j]) for j, key in enumerate(METRIC_UNITS)), k

@@ -447,7 +447,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
             points[k] = _check_system(c.beam, c.contactors, c.excitation, c.initial, c.options, c.points, "exact")
             if c.options.modes == "auto":
                 raise _CaseByCase
-            key = (pack_key(c.beam, c.contactors, c.damping, c.excitation, c.options, c.preload), c.initial,
+            key = (pack_key(c.beam, c.contactors, c.damping, c.excitation, c.options, c.preload), c.initial.key(),
                    response_point(c.contactors, points[k])[0])
             groups.setdefault(key, []).append(k)
         except _CaseByCase:
@@ -471,24 +471,51 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
                 scalars[ks[0]] = [np.nan if m[name] is None else m[name] for name in METRIC_UNITS]
                 status[ks[0]] = res.status
                 messages[ks[0]] = res.message
+            done += 1
         else:
-            x = key[2]
-            signs = [response_point(cases[k].contactors, points[k])[1] for k in ks]
-            br = integrate_batch(first.beam, [cases[k].contactors for k in ks], first.damping,
-                                 [cases[k].excitation for k in ks], first.initial, [cases[k].options for k in ks],
-                                 point=x, sign=np.array(signs), preload=first.preload, progress=None if progress is None else
-                                 (lambda j, done=done: progress(done + j)))
-            scalars[ks] = br.scalars
-            status[ks] = br.status
-            for j, k in enumerate(ks):
-                messages[k] = br.messages[j]
-                errors[k] = br.errors[j]
-                for text in br.warnings[j]:
-                    warn(text)
-        done += len(ks)
+            for part in _memory_parts(ks, [case_bytes(cases[k]) for k in ks]):
+                x = key[2]
+                signs = [response_point(cases[k].contactors, points[k])[1] for k in part]
+                br = integrate_batch(first.beam, [cases[k].contactors for k in part], first.damping,
+                                     [cases[k].excitation for k in part], first.initial,
+                                     [cases[k].options for k in part], point=x, sign=np.array(signs),
+                                     preload=first.preload,
+                                     progress=None if progress is None else (lambda j, done=done: progress(done + j)))
+                scalars[part] = br.scalars
+                status[part] = br.status
+                for j, k in enumerate(part):
+                    messages[k] = br.messages[j]
+                    errors[k] = br.errors[j]
+                    for text in br.warnings[j]:
+                        warn(text)
+                done += len(part)
         if progress is not None:
             progress(done)
     return CaseMetrics(scalars, status, messages, errors)
+
+
+#: Bytes of load pieces one compiled batch may hold (a batch pads every case's pieces to the longest).
+BATCH_BYTES = 64 * 2**20
+
+
+def case_bytes(case: Case) -> int:
+    """Memory a case brings to a batch: its load samples and their pieces, padded (8-byte values, 2 + 7 columns)."""
+    times = case.excitation.times
+    return 72 * (4 + (0 if times is None else int(times.size)))
+
+
+def _memory_parts(ks: list[int], sizes: list[int]) -> list[list[int]]:
+    """``ks`` cut into runs whose padded pieces (count x largest) stay within :data:`BATCH_BYTES` (one case at least)."""
+    parts: list[list[int]] = []
+    largest = 0
+    for k, size in zip(ks, sizes):
+        largest = max(largest, size)
+        if parts and (len(parts[-1]) + 1) * largest <= BATCH_BYTES:
+            parts[-1].append(k)
+        else:
+            parts.append([k])
+            largest = size
+    return parts
 
 
 class _CaseByCase(Exception):

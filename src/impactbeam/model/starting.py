@@ -11,6 +11,7 @@ projects every field on the run's modes
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -187,6 +188,18 @@ class InitialCondition:
             and (self.velocity_profile is None or not np.any(self.velocity_profile.values))
             and not self.equilibrium
         )
+
+    def key(self) -> tuple:
+        """A hashable value of the whole state (profiles by their tables): equal keys, equal starts.
+
+        Instances compare by identity (their profiles hold arrays); runs that
+        may share a start state (the batches of a sweep) compare keys.
+        """
+        out: list = []
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            out.append((v.positions.tobytes(), v.values.tobytes()) if isinstance(v, Profile) else v)
+        return tuple(out)
 
 
 PreloadKind = Literal["gravity", "base_acceleration", "point_force"]

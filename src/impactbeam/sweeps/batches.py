@@ -286,7 +286,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
         The cases of one chunk of the store.
     """
     from ..result.metrics import METRIC_UNITS
-    from ..simulation import run_cases
+    from ..simulation import BATCH_BYTES, case_bytes, run_cases
 
     _tune_malloc()
     n = len(batch.values)
@@ -297,23 +297,28 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     whole = batch.history_times is not None or batch.statistics or not set(batch.metrics) <= set(METRIC_UNITS)
     if whole:  # histories, statistics and the stress metrics need each case's whole result
         return _run_one_by_one(batch, builder.base, out, status, message)
-    built = builder.cases(batch.values)
-    ok = [k for k, c in enumerate(built) if not isinstance(c, Exception)]
-    res = run_cases([built[k] for k in ok])
     columns = [list(METRIC_UNITS).index(m) for m in batch.metrics]
-    row = {k: j for j, k in enumerate(ok)}
-    for k, c in enumerate(built):
-        err = c if isinstance(c, Exception) else res.errors[row[k]]
-        if err is not None:  # the first failing case, in case order, when errors stop the sweep
-            if batch.on_error == "raise":
-                raise err
-            message[k] = _error_message(err)
-            continue
-        j = row[k]
-        for m, col in zip(batch.metrics, columns):
-            out[m][k] = res.scalars[j, col]
-        status[k] = res.status[j]
-        message[k] = "" if res.status[j] == 0 else " ".join(str(res.messages[j]).split())
+    lo, step = 0, 1  # the first case alone gives the memory of one (a long random load: megabytes)
+    while lo < n:
+        built = builder.cases(batch.values[lo: lo + step])
+        ok = [k for k, c in enumerate(built) if not isinstance(c, Exception)]
+        res = run_cases([built[k] for k in ok])
+        row = {k: j for j, k in enumerate(ok)}
+        for k, c in enumerate(built):
+            err = c if isinstance(c, Exception) else res.errors[row[k]]
+            if err is not None:  # the first failing case, in case order, when errors stop the sweep
+                if batch.on_error == "raise":
+                    raise err
+                message[lo + k] = _error_message(err)
+                continue
+            j = row[k]
+            for m, col in zip(batch.metrics, columns):
+                out[m][lo + k] = res.scalars[j, col]
+            status[lo + k] = res.status[j]
+            message[lo + k] = "" if res.status[j] == 0 else " ".join(str(res.messages[j]).split())
+        if step == 1 and ok:  # then as many at once as the batch memory allows
+            step = max(1, BATCH_BYTES // max(case_bytes(built[ok[0]]), 1))
+        lo += len(built)
     out["status"] = status
     out["message"] = message
     return out
