@@ -12,8 +12,9 @@ alone, so units, checks and messages are the parser's), which gives the
 same model objects as re-parsing every case (a test compares them). A case
 the direct route cannot build (an invalid value, or a value the model
 objects refuse in combination) is parsed whole, as before, so its error
-message is the same. Sampled designs, whose values are all distinct, parse
-every case whole.
+message is the same. So is a case whose direct value the parser derives
+more from (a random load's record is drawn for ``solver.end_time``). Sampled
+designs, whose values are all distinct, parse every case whole.
 """
 
 from __future__ import annotations
@@ -209,7 +210,7 @@ class _CaseBuilder:
             except Exception as exc:
                 group = exc
             self._groups[gkey] = group
-        if isinstance(group, Exception):
+        if isinstance(group, Exception) or self._record_depends(group):
             return None
         changes: dict[str, list[tuple[Any, ...]]] = {"contactors": [], "excitation": [], "solver": []}
         for i in self.direct:
@@ -226,6 +227,11 @@ class _CaseBuilder:
             return None
         return Case(group.beam, contactors, group.damping, ex, group.initial, solver, group.output_points,
                     group.preload)
+
+    def _record_depends(self, group: Any) -> bool:
+        """Whether a direct value also changes what the parser derives from it: a random load's record lasts
+        ``solver.end_time`` and is drawn when the scenario is read, so those cases are read whole."""
+        return group.excitation.shape == "random" and any(self.paths[i] == "solver.end_time" for i in self.direct)
 
     def _made(self, section: str, gkey: str, changes: list[tuple[Any, ...]], group: Any) -> Any:
         """The group's contactors, excitation or solver options with ``changes`` made (one object per change set)."""
