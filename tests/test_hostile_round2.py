@@ -572,7 +572,10 @@ def test_ctrl_c_stops_the_timoshenko_mode_search(tmp_path: Path) -> None:
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     time.sleep(2.0)  # start-up ~1 s; the two mode sets then take ~3 s each (the second was 305 s before)
-    assert proc.poll() is None, proc.communicate()
+    if proc.poll() is not None:  # a machine fast enough to finish both first: nothing to interrupt
+        out, err = proc.communicate()
+        assert proc.returncode == 0, err
+        pytest.skip("modes --count 200 finished within 2 s: no search left to interrupt")
     t0 = time.monotonic()
     os.killpg(proc.pid, signal.SIGINT)
     _, err = proc.communicate(timeout=60)
