@@ -99,3 +99,19 @@ def test_progress_into_a_pipe_is_whole_lines_before_the_warnings():
     assert lines[0].startswith("simulate:  25% (0.25/1 s)"), err
     assert lines[-2].startswith("simulate: 100% (1/1 s)"), err
     assert lines[-1] == "warning: too stiff", err
+
+
+def test_a_sweep_into_a_pipe_reports_progress_in_whole_lines(tmp_path):
+    # The sweep, the paper's reproduction and the commands share one progress rule
+    # (impactbeam._warnings.Progress): into a pipe, lines without carriage returns.
+    spec = tmp_path / "s.toml"
+    spec.write_text(f'base = "{(EXAMPLES / "case03.toml").as_posix()}"\ndesign = "grid"\n'
+                    '[parameters."contactors.0.gap"]\nvalues = [0.0, 1e-4]\n[outputs]\nmetrics = ["max_response"]\n')
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run([sys.executable, "-m", "impactbeam", "sweep", str(spec), "--out", str(tmp_path / "o.zarr"),
+                           "--workers", "0"], capture_output=True, env=env, timeout=600)  # bytes: "\r" kept
+    err = proc.stderr.decode()
+    assert proc.returncode == 0, err
+    assert "\r" not in err
+    lines = [ln for ln in err.splitlines() if ln.startswith("sweep:")]
+    assert lines and lines[-1].startswith("sweep: 100% (2/2 case)"), err

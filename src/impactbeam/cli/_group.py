@@ -21,18 +21,16 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import functools
-import math
 import os
 import signal
 import sys
 import threading
-import time
 from collections.abc import Callable, Iterator, Mapping
 from typing import Any, TypeVar
 
 import click
 
-from .._warnings import WarningLog
+from .._warnings import Progress, WarningLog
 from ..exceptions import ImpactBeamError, ParameterError
 
 __all__ = ["main", "handle_errors", "take_warnings", "warning_lines", "load_with_overrides", "Interrupted", "fail", "progress_bar", "number_or_text"]
@@ -162,13 +160,7 @@ def load_with_overrides(path: str, overrides: Mapping[str, Any] | None = None) -
 def progress_bar(
     total: float, *, desc: str, unit: str, after: float = 2.0, **tqdm_options: Any
 ) -> Iterator[Callable[[float], None]]:
-    """A callback ``report(done)`` that shows progress on stderr once a command has run ``after`` seconds.
-
-    On a terminal it is a :class:`tqdm.tqdm` bar, redrawn in place. Into a
-    file or a pipe (a CI log, ``2> log``) it is whole lines,
-    ``desc: 40% (0.08/0.2 s) after 12 s``, at most one every 10 s and one
-    when the work ends, written through the stream the warnings and errors
-    use: a bar's carriage returns would run into them.
+    """A callback ``report(done)`` showing a command's progress on stderr (:class:`~impactbeam._warnings.Progress`).
 
     Parameters
     ----------
@@ -179,56 +171,10 @@ def progress_bar(
     after : float, [s]
         Quiet for short commands: nothing before this much wall time.
     **tqdm_options
-        Passed to :class:`tqdm.tqdm` (e.g. ``unit_scale``, ``bar_format``).
+        Passed to :class:`tqdm.tqdm` on a terminal (e.g. ``unit_scale``, ``bar_format``).
     """
-    start = time.monotonic()
-    bar: Any = None
-    lines = {"last": -math.inf, "done": 0.0, "shown": False}
-    interactive = _is_terminal(sys.stderr)
-
-    def line(done: float) -> None:
-        pct = 100.0 * done / total if total > 0 else 100.0
-        click.echo(f"{desc}: {pct:3.0f}% ({done:.4g}/{total:.4g}{' ' + unit if unit else ''}) "
-                   f"after {time.monotonic() - start:.0f} s", err=True)
-        lines.update(last=time.monotonic(), shown=True)
-
-    def report(done: float) -> None:
-        nonlocal bar
-        done = max(0.0, min(done, total))
-        now = time.monotonic()
-        if now - start <= after:
-            lines["done"] = done
-            return
-        if not interactive:
-            lines["done"] = done
-            if now - lines["last"] >= _LINE_EVERY:
-                line(done)
-            return
-        if bar is None:
-            from tqdm import tqdm
-
-            bar = tqdm(total=total, unit=unit, desc=desc, file=sys.stderr, **tqdm_options)
-        bar.update(done - bar.n)
-
-    try:
+    with Progress(total, desc=desc, unit=unit, after=after, **tqdm_options) as report:
         yield report
-    finally:
-        if bar is not None:
-            bar.close()
-            sys.stderr.flush()  # the bar's last line is out before any warning or error line
-        elif lines["shown"]:
-            line(lines["done"])  # the end, or where an interrupted or failed run stopped
-
-
-#: Seconds between two progress lines written into a file or a pipe.
-_LINE_EVERY = 10.0
-
-
-def _is_terminal(stream: Any) -> bool:
-    try:
-        return bool(stream.isatty())
-    except (AttributeError, ValueError):
-        return False
 
 
 class Interrupted(KeyboardInterrupt):

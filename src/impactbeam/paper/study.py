@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -20,6 +19,7 @@ if TYPE_CHECKING:
 from .conventions import PaperMetrics, paper_metrics
 from .data import PAPER_FREQUENCIES, SECTION4, TABLE1, TABLE2_MEASURED
 from .._io import write_text
+from .._warnings import Progress
 from ..experiment.damping import ratio_from_decrement
 from .document import _document
 from .figures import _figures
@@ -115,7 +115,7 @@ def reproduce(out_dir: str | os.PathLike[str], *, progress: bool = True) -> Repr
     out_dir : path-like
         Created if missing.
     progress : bool
-        Show a progress bar (tqdm) on stderr.
+        Show progress on stderr (a bar on a terminal, lines into a file or a pipe).
 
     Returns
     -------
@@ -136,25 +136,18 @@ def reproduce(out_dir: str | os.PathLike[str], *, progress: bool = True) -> Repr
     fig_dir.mkdir(parents=True, exist_ok=True)
 
     n_figs = N_FIGURES
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=planned_simulations() + n_figs, file=sys.stderr, unit="step", desc="reproduce",
+    bar = Progress(planned_simulations() + n_figs, desc="reproduce", unit="step", enabled=progress, after=0.0,
                    dynamic_ncols=True, leave=True)
 
     def tick(label: str) -> None:
-        if bar is not None:
-            bar.set_postfix_str(label[:40], refresh=False)
-            bar.update(1)
+        bar.advance(1)
 
     runner = _Runner(tick)
     try:
         data = _compute(runner)
         figures = _figures(data, fig_dir, tick)
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
     report = _assemble(data, out, figures, runner.count, time.perf_counter() - t_start)
     doc = _document(report, data)
     write_text(report.report_md, doc.markdown())

@@ -15,6 +15,7 @@ import numpy as np
 
 from .._io import WriteError, check_writable, write_error
 from .._optional import require
+from .._warnings import Progress
 from ..exceptions import ImpactBeamError, ParameterError, SimulationError
 if TYPE_CHECKING:
     import xarray as xr
@@ -183,7 +184,7 @@ def run_sweep(
     batch_size : int, optional
         Cases per batch (one Zarr chunk).
     progress : bool
-        Show a progress bar on stderr.
+        Show progress on stderr (a bar on a terminal, lines into a file or a pipe).
     on_error : {"record", "raise"}
         Record a failed case (status -1) or raise.
     """
@@ -259,10 +260,8 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
             skipped = int((status != NOT_RUN).sum())
             n_todo = spec.n_cases - skipped
 
-            from tqdm.auto import tqdm
-
-            bar = tqdm(total=spec.n_cases, initial=spec.n_cases - n_todo, desc="sweep", unit="case",
-                       file=sys.stderr, disable=not progress, dynamic_ncols=True)
+            bar = Progress(spec.n_cases, desc="sweep", unit="case", enabled=progress, done=spec.n_cases - n_todo,
+                           after=0.0, dynamic_ncols=True)
 
             def done(region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
                 with guard.write():
@@ -270,7 +269,7 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
                 n = len(res["status"])
                 counts["computed"] += n
                 counts["failed"] += int((np.asarray(res["status"]) == FAILED).sum())
-                bar.update(n)  # type: ignore[union-attr]
+                bar.advance(n)  # type: ignore[union-attr]
 
             if n_todo:
                 batches = (_make_batch(spec, r, on_error) for r in regions)
@@ -490,7 +489,7 @@ def sweep(
         Cases per task (= per Zarr chunk); default :func:`default_batch_size`.
         A resumed store keeps its own batches.
     progress : bool
-        Progress bar on stderr (tqdm).
+        Progress on stderr (a bar on a terminal, lines into a file or a pipe).
     on_error : {"record", "raise"}
         ``record``: a case that fails gets status -1, its error in ``message``
         and NaN metrics, and the sweep goes on; ``raise``: the first failure
