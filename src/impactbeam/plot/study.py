@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -67,20 +67,7 @@ def plot_parameter_study(
     if not names:
         raise ParameterError("metrics: at least one metric is needed")
     xv = np.asarray(values, dtype=float)
-    if axes is None:
-        ncols = 2 if len(names) > 1 else 1
-        nrows = math.ceil(len(names) / ncols)
-        width = figure_size(size)[0]
-        fig, grid = _new_figure((width, (0.3 if ncols == 2 else 0.55) * width * nrows + 0.3), nrows, ncols)
-        axes = list(grid.ravel())
-        for extra in axes[len(names):]:
-            extra.set_visible(False)
-        axes = axes[: len(names)]
-    else:
-        axes = list(axes)
-        if len(axes) < len(names):
-            raise ParameterError(f"axes: {len(axes)} axes for {len(names)} metrics")
-        fig = axes[0].figure
+    fig, axes = _metric_panels(names, axes, size, lambda ncols, width: (0.3 if ncols == 2 else 0.55) * width, 0.3)
     labels = dict(metric_labels or {})
     lines = []
     for a, name in zip(axes, names):
@@ -224,20 +211,7 @@ def plot_convergence_study(
     if not names:
         raise ParameterError("values: at least one metric is needed")
     n = np.asarray(modes, dtype=float)
-    if axes is None:
-        ncols = 2 if len(names) > 1 else 1
-        nrows = math.ceil(len(names) / ncols)
-        width = figure_size(size)[0]
-        fig, grid = _new_figure((width, 0.32 * width * nrows + 0.5), nrows, ncols, sharex=True)
-        axes = list(np.atleast_1d(grid).ravel())
-        for extra in axes[len(names):]:
-            extra.set_visible(False)
-        axes = axes[: len(names)]
-    else:
-        axes = list(axes)
-        if len(axes) < len(names):
-            raise ParameterError(f"axes: {len(axes)} axes for {len(names)} metrics")
-        fig = axes[0].figure
+    fig, axes = _metric_panels(names, axes, size, lambda ncols, width: 0.32 * width, 0.5, sharex=True)
     labels = dict(metric_labels or {})
     lines = []
     for a, name in zip(axes, names):
@@ -285,3 +259,24 @@ def _decade_ticks(axis, lo: float, hi: float) -> None:
     axis.set_major_locator(ticker.LogLocator(base=10.0 ** step, numticks=12))
     axis.set_major_formatter(ticker.LogFormatterSciNotation(base=10.0))
     axis.set_minor_locator(ticker.NullLocator())
+
+
+def _metric_panels(names: list[str], axes: Any, size: Any, row_height: Any, margin: float,
+                   **grid_options: Any) -> tuple[Any, list[Any]]:
+    """One panel per metric: the given ``axes``, or a grid of two columns (one for a single metric).
+
+    ``row_height(ncols, width)`` [in] is the height of a row of the new grid, ``margin`` [in] added once.
+    """
+    if axes is not None:
+        axes = list(axes)
+        if len(axes) < len(names):
+            raise ParameterError(f"axes: {len(axes)} axes for {len(names)} metrics")
+        return axes[0].figure, axes
+    ncols = 2 if len(names) > 1 else 1
+    nrows = math.ceil(len(names) / ncols)
+    width = figure_size(size)[0]
+    fig, grid = _new_figure((width, row_height(ncols, width) * nrows + margin), nrows, ncols, **grid_options)
+    panels = list(np.atleast_1d(grid).ravel())
+    for extra in panels[len(names):]:
+        extra.set_visible(False)
+    return fig, panels[: len(names)]
