@@ -220,7 +220,7 @@ def test_derivatives_are_those_of_the_closed_form():
     v = np.array([0.7, -1.1, 0.4])
     out, mag = np.empty(4), np.empty(4)
     _closed.derivatives(v, np.zeros(3), 0.25, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, np.zeros((3, 3)),
-                        seg.Om, seg.phi, 3, out, mag)
+                        seg.Om, seg.phi, 3, out, mag, np.empty((2, 5)))
     h = 1e-3
     taus = np.array([0.0, h, 2 * h, 3 * h, 4 * h])
     eta, deta = seg.evaluate(taus)
@@ -325,7 +325,7 @@ def test_rows_on_rates_project_exactly():
     assert exact == pytest.approx(quad, rel=1e-12, abs=1e-13)
     out, mag = np.empty(4), np.empty(4)
     AL = np.tile(np.asarray(alpha), (n, 1))
-    _closed.derivatives(v, u, 0.0, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, AL, Om, phi, 3, out, mag)
+    _closed.derivatives(v, u, 0.0, seg.a, seg.om, seg.eta0, seg.deta0, *seg.load, AL, Om, phi, 3, out, mag, np.empty((2, 5)))
     assert out[0] == pytest.approx(direct[0], rel=1e-13)
     # the second derivative from the equation of motion against the one from the kernels (another formula)
     _, d1, d2 = _row3(0.0, seg.reg, seg.a, seg.w, seg.om, VH, VD, np.zeros(1), PV, Om, phi)

@@ -59,7 +59,7 @@ EPS = 2.220446049250313e-16
 NP = 8  # coefficients of a particular part
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def kernel(reg, a, w, tau):  # pragma: no cover - compiled
     """``(e_C, e_S)`` of one coordinate at ``tau >= 0`` (see the module docstring)."""
     if reg == REG_UNDER:
@@ -73,7 +73,7 @@ def kernel(reg, a, w, tau):  # pragma: no cover - compiled
     return 0.5 * ep * (1.0 + math.exp(x)), -0.5 * ep * math.expm1(x) / w
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def particular(p, tau, Om, phi):  # pragma: no cover - compiled
     """Particular part and its derivative from the eight coefficients ``p``."""
     val = p[0] + tau * (p[1] + tau * (p[2] + tau * p[3]))
@@ -87,20 +87,13 @@ def particular(p, tau, Om, phi):  # pragma: no cover - compiled
     return val, der
 
 
-@njit(cache=True, nogil=True)
-def derivative_coefficients(p, Om, out):  # pragma: no cover - compiled
-    """The eight coefficients of the derivative of the particular part ``p``."""
-    out[0] = p[1]
-    out[1] = 2.0 * p[2]
-    out[2] = 3.0 * p[3]
-    out[3] = 0.0
-    out[4] = -Om * p[5] + p[7]
-    out[5] = Om * p[4] + p[6]
-    out[6] = Om * p[7]
-    out[7] = -Om * p[6]
+@njit(cache=True, nogil=True, _nrt=False)
+def derivative_coefficients(p, Om):  # pragma: no cover - compiled
+    """The eight coefficients of the derivative of the particular part ``p`` (a tuple)."""
+    return (p[1], 2.0 * p[2], 3.0 * p[3], 0.0, -Om * p[5] + p[7], Om * p[4] + p[6], Om * p[7], -Om * p[6])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def setup(reg, a, om, load_A, load_B, load_D, load_E, Om, phi, eta0, deta0, h0, dh0, P):  # pragma: no cover
     """Coefficients of a segment from its loads and initial state.
 
@@ -154,7 +147,7 @@ def setup(reg, a, om, load_A, load_B, load_D, load_E, Om, phi, eta0, deta0, h0, 
         dh0[n] = deta0[n] - dp0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover - compiled
     """Coordinates ``e`` and rates ``d`` at ``tau`` (filled in place)."""
     for n in range(om.size):
@@ -164,7 +157,7 @@ def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover
         d[n] = -om[n] * om[n] * eS * h0[n] + (eC - a[n] * eS) * dh0[n] + pd
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def project(V, U, base, a, om, h0, dh0, P, AL, Om, VH, VD, PV, rows):  # pragma: no cover - compiled
     """Write the rows ``base + V z + U (z' - alpha)`` of one segment as ``(VH, VD, PV)``.
 
@@ -174,28 +167,33 @@ def project(V, U, base, a, om, h0, dh0, P, AL, Om, VH, VD, PV, rows):  # pragma:
     ``c``; ``PV[c]`` the coefficients of the row's particular part (without
     ``base``). Only the first ``rows`` rows are written.
     """
-    dP = np.empty(NP)
     for c in range(rows):
         for q in range(NP):
             PV[c, q] = 0.0
     for n in range(h0.size):
         o2 = om[n] * om[n]
         ddh = -2.0 * a[n] * dh0[n] - o2 * h0[n]
-        derivative_coefficients(P[n], Om, dP)
-        dP[0] -= AL[n, 0]
-        dP[1] -= AL[n, 1]
-        dP[4] -= AL[n, 2]
+        d0, d1, d2, d3, d4, d5, d6, d7 = derivative_coefficients(P[n], Om)
+        d0 -= AL[n, 0]
+        d1 -= AL[n, 1]
+        d4 -= AL[n, 2]
         for c in range(rows):
             v = V[c, n]
             u = U[c, n]
             VH[c, n] = v * h0[n] + u * dh0[n]
             VD[c, n] = v * dh0[n] + u * ddh
             if v != 0.0 or u != 0.0:
-                for q in range(NP):
-                    PV[c, q] += v * P[n, q] + u * dP[q]
+                PV[c, 0] += v * P[n, 0] + u * d0
+                PV[c, 1] += v * P[n, 1] + u * d1
+                PV[c, 2] += v * P[n, 2] + u * d2
+                PV[c, 3] += v * P[n, 3] + u * d3
+                PV[c, 4] += v * P[n, 4] + u * d4
+                PV[c, 5] += v * P[n, 5] + u * d5
+                PV[c, 6] += v * P[n, 6] + u * d6
+                PV[c, 7] += v * P[n, 7] + u * d7
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _particular_curvature(p, Om, tmax):  # pragma: no cover - compiled
     """Bound on the second derivative of the particular part ``p`` on ``[0, tmax]``."""
     W = abs(Om)
@@ -205,7 +203,7 @@ def _particular_curvature(p, Om, tmax):  # pragma: no cover - compiled
     return m
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _particular_jerk(p, Om, tmax):  # pragma: no cover - compiled
     """Bound on the third derivative of the particular part ``p`` on ``[0, tmax]``."""
     W = abs(Om)
@@ -216,7 +214,7 @@ def _particular_jerk(p, Om, tmax):  # pragma: no cover - compiled
     return m
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def curvature_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compiled
     """Bound on the second derivative of each row over ``[0, tau_end]``.
 
@@ -241,7 +239,7 @@ def curvature_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - 
         out[c] *= 1.0 + 1e-12  # round-off margin
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def jerk_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compiled
     """Bound on the third derivative of each row over ``[0, tau_end]``.
 
@@ -263,7 +261,7 @@ def jerk_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compi
         out[c] *= 1.0 + 1e-12
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, out, work_h, work_d):  # pragma: no cover
     """:func:`curvature_bound` valid on ``[tau, tau_end]``, from the homogeneous parts at ``tau``.
 
@@ -283,7 +281,7 @@ def curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, out, work_h,
     curvature_bound(work_h, work_d, a, om, PV, Om, tau_end, out)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def ipow(x, n):  # pragma: no cover - compiled
     """``x**n`` for an integer ``n >= 0`` by repeated squaring, as numba computes a float to an integer power.
 
@@ -299,7 +297,7 @@ def ipow(x, n):  # pragma: no cover - compiled
     return r
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _load_derivative(A, B, D, E, Om, sphi, cphi, j):  # pragma: no cover - compiled
     """``d^j/dtau^j (A + B tau + D sin theta + E cos theta)`` at ``tau = 0``."""
     if j == 0:
@@ -317,14 +315,15 @@ def _load_derivative(A, B, D, E, Om, sphi, cphi, j):  # pragma: no cover - compi
     return -s * (D * cphi - E * sphi)
 
 
-@njit(cache=True, nogil=True)
-def derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, out, mag):
+@njit(cache=True, nogil=True, _nrt=False)
+def derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, out, mag, work):
     # pragma: no cover - compiled
     """Exact derivatives ``d^k/dtau^k (base + v z + u (z' - alpha))`` at ``tau = 0``, k = 0..kmax.
 
     From the equation of motion, ``z^(k+2) = f^(k) - 2a z^(k+1) - omega^2
     z^(k)``; ``mag[k]`` is the same sum taken with absolute values (the scale
-    against which a derivative counts as zero up to round-off).
+    against which a derivative counts as zero up to round-off). ``work``: a
+    scratch array of shape ``(2, kmax + 2)``.
     """
     sphi = math.sin(phi)
     cphi = math.cos(phi)
@@ -333,8 +332,8 @@ def derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, 
         mag[k] = 0.0
     out[0] = base
     mag[0] = abs(base)
-    hist = np.empty(kmax + 2)
-    habs = np.empty(kmax + 2)
+    hist = work[0]
+    habs = work[1]
     for n in range(om.size):
         vn = v[n]
         un = u[n]
@@ -356,7 +355,7 @@ def derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, 
             mag[k] += abs(vn) * habs[k] + abs(un) * (habs[k + 1] + abs(al))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _integral_particular(p, Om, phi, T):  # pragma: no cover - compiled
     """``int_0^T`` of the particular part ``p``."""
     ip = T * (p[0] + T * (p[1] / 2.0 + T * (p[2] / 3.0 + T * p[3] / 4.0)))
@@ -374,7 +373,7 @@ def _integral_particular(p, Om, phi, T):  # pragma: no cover - compiled
     return ip
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def integral_of(VH, VD, PV, reg, a, w, om, Om, phi, T):  # pragma: no cover - compiled
     """``int_0^T`` of row 0 of a projection (:func:`project`), without its base, in closed form.
 
@@ -402,7 +401,7 @@ def integral_of(VH, VD, PV, reg, a, w, om, Om, phi, T):  # pragma: no cover - co
     return total
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def segment_setup(s, kp, t, eta, deta, reg, dec, om, bu, au, Bc, Ac, bp, ap, smask, gap, side, kst,
                   pt0, pconst, pslope, pamp, pOm, pphase, h0, dh0, P, lA, lB, lD, lE, AL):
     # pragma: no cover - compiled
@@ -450,7 +449,7 @@ def segment_setup(s, kp, t, eta, deta, reg, dec, om, bu, au, Bc, Ac, bp, ap, sma
     return Om, phi
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def alpha_at(AL, tau, Om, phi, out):  # pragma: no cover - compiled
     """``alpha_n(tau)`` of every coordinate (:func:`segment_setup`)."""
     s = math.sin(Om * tau + phi) if Om != 0.0 else math.sin(phi)
@@ -458,7 +457,7 @@ def alpha_at(AL, tau, Om, phi, out):  # pragma: no cover - compiled
         out[n] = AL[n, 0] + AL[n, 1] * tau + AL[n, 2] * s
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def copy_into(dst, src):  # pragma: no cover - compiled
     """``dst[:] = src`` for two 1-D arrays of one length, as a loop.
 

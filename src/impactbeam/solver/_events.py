@@ -47,7 +47,7 @@ VALUE = np.int64(0)
 SLOPE = np.int64(1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
     """``(h_c, h_c')`` of one row at ``tau``."""
     pv, pd = particular(PV[c], tau, Om, phi)
@@ -60,13 +60,13 @@ def row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cove
     return g, dg
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _f(which, c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
     g, dg = row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi)
     return g if which == 0 else dg
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover
     """Root of ``h_c`` (which = 0) or ``h_c'`` (which = 1) in ``[xa, xb]`` bracketing a sign change.
 
@@ -127,7 +127,7 @@ def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, p
     return xcur
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def safe_step(h, dh, M):  # pragma: no cover - compiled
     """Largest ``s`` with ``h + dh s - M s^2/2 > 0`` (``h > 0``); inf if unbounded."""
     if M <= 0.0:
@@ -138,7 +138,7 @@ def safe_step(h, dh, M):  # pragma: no cover - compiled
     return 2.0 * h / (q - dh)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _monotone(d0, d1, M, L, sign):  # pragma: no cover - compiled
     """True when ``sign * h' > 0`` is proven on an interval of length L with end slopes d0, d1."""
     s0 = sign * d0
@@ -148,7 +148,7 @@ def _monotone(d0, d1, M, L, sign):  # pragma: no cover - compiled
     return M <= 0.0 or (s0 + s1) >= M * L
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
     # pragma: no cover - compiled
     """First switching time of row ``c`` in ``(ta, tb]``, or NaN (see the module docstring).
@@ -227,7 +227,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
     return np.nan
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, stack, reg, a, w, om, VH, VD, base, PV,
          Om, phi, work_h, work_d):
     # pragma: no cover - compiled
@@ -288,17 +288,18 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
     return tau_end, -1, used
 
 
-@njit(cache=True, nogil=True)
-def departure(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, dvec, mag):
+@njit(cache=True, nogil=True, _nrt=False)
+def departure(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, dvec, mag, work):
     # pragma: no cover - compiled
     """Sign (-1, 0, +1) of the first derivative of the row ``(v, u, base)`` at 0 that is not round-off.
 
     A derivative counts as zero when it is below ``64 eps`` times the same sum
     taken with absolute values (:func:`~impactbeam.solver._closed.derivatives`).
-    Orders 1 to ``dvec.size - 1`` are tried; 0 when all vanish (e.g. at rest).
+    Orders 1 to ``dvec.size - 1`` are tried; 0 when all vanish (e.g. at rest). ``work``: scratch of
+    shape ``(2, dvec.size + 1)``.
     """
     kmax = dvec.size - 1
-    derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, dvec, mag)
+    derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, dvec, mag, work)
     for k in range(1, kmax + 1):
         if abs(dvec[k]) > 64.0 * EPS * mag[k]:
             return 1 if dvec[k] > 0.0 else -1

@@ -71,7 +71,7 @@ KMAX = 5  # highest derivative used to judge a tangency
 ROW_MAIN, ROW_PHASE = 0, 1  # a contactor's switching row; the end of its released phase
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _dot(x, y):  # pragma: no cover - compiled
     s = 0.0
     for n in range(x.size):
@@ -79,13 +79,13 @@ def _dot(x, y):  # pragma: no cover - compiled
     return s
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _zero(x):  # pragma: no cover - compiled
     for i in range(x.size):
         x[i] = 0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def energy(mask, e, d, omo, Wc, gap, side, kst):  # pragma: no cover - compiled
     """Mechanical energy from the modal frame: beam, end supports and engaged contactors (with their gaps)."""
     E = 0.0
@@ -99,7 +99,7 @@ def energy(mask, e, d, omo, Wc, gap, side, kst):  # pragma: no cover - compiled
     return E
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def to_modal(gen, G, z, dz, alpha, e, d):  # pragma: no cover - compiled
     """Modal-frame displacement ``e`` and velocity ``d`` of a slot's coordinates ``z, z'``."""
     nm = z.size
@@ -118,7 +118,7 @@ def to_modal(gen, G, z, dz, alpha, e, d):  # pragma: no cover - compiled
         d[m] = sd
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _find(keys, n, key):  # pragma: no cover - compiled
     for i in range(n):
         if keys[i] == key:
@@ -126,7 +126,7 @@ def _find(keys, n, key):  # pragma: no cover - compiled
     return -1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def load_value(kp, t, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
     """The excitation's time law ``u(t)`` in piece ``kp``."""
     tp = t - pt0[kp]
@@ -136,7 +136,7 @@ def load_value(kp, t, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cov
     return u
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm, tr_from, tr_to,
             gap, side, kst, dash, phase, u_now, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps, tol_h, work):
     # pragma: no cover - compiled
@@ -227,7 +227,7 @@ def _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm,
     return -1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def contactor_rows(s, mask, RW, gap, side, kst, dash, phase, V, U, base, rowc, rowk):  # pragma: no cover
     """The switching rows of slot ``s`` (positive while the state holds); their number.
 
@@ -259,9 +259,9 @@ def contactor_rows(s, mask, RW, gap, side, kst, dash, phase, V, U, base, rowc, r
     return nr
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD, lE, AL, Om, phi, toggles,
-                 tol_h, dvec, mag):  # pragma: no cover - compiled
+                 tol_h, dvec, mag, dwork):  # pragma: no cover - compiled
     """Row to act on at the segment start (inconsistent, or departing into its stop), or -1."""
     just = ic[I_JUST]
     for r in range(nr):
@@ -270,7 +270,8 @@ def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD
         c = rowc[r]
         bad = g[r] < -tol_h and c != just
         if not bad:
-            bad = departure(V[r], U[r], base[r], dec, om, eta, deta, lA, lB, lD, lE, AL, Om, phi, dvec, mag) < 0
+            bad = departure(V[r], U[r], base[r], dec, om, eta, deta, lA, lB, lD, lE, AL, Om, phi, dvec, mag,
+                            dwork) < 0
         if bad:
             t = fc[F_T]
             if t != fc[F_LAST_T]:
@@ -280,6 +281,21 @@ def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD
             if toggles[c] <= 2:
                 return r
     return -1
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _openings(PV, VH, VD, base, nr, Om, phi, tol_h, g, dg):  # pragma: no cover - compiled
+    """The first ``nr`` rows' values ``g`` and slopes ``dg`` at the segment start; True if one is within ``tol_h``."""
+    touching = False
+    for r in range(nr):
+        pv, pd = particular(PV[r], 0.0, Om, phi)
+        g[r] = base[r] + pv
+        dg[r] = pd
+        for n in range(VH.shape[1]):
+            g[r] += VH[r, n]
+            dg[r] += VD[r, n]
+        touching = touching or g[r] <= tol_h
+    return touching
 
 
 @njit(cache=True, nogil=True)
@@ -296,29 +312,33 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
     not depend on where the run returned to Python.
     """
     nm = eta.size
+    nrm = 2 * gap.size
+    h0, dh0, P, lA, lB, lD, lE, AL = workspace(nm)
+    vectors = (h0, dh0, lA, lB, lD, lE, np.empty(nm), np.empty(nrm), np.empty(nrm), np.empty(nrm), np.empty(nrm),
+               np.empty(nrm), np.empty(nrm), np.empty(KMAX + 1), np.empty(KMAX + 1))
+    matrices = (P, AL, np.empty((nrm, nm)), np.empty((nrm, nm)), np.empty((nrm, nm)), np.empty((nrm, nm)),
+                np.empty((nrm, nm)), np.empty((nrm, nm)), np.empty((nrm, NP)), np.empty((96, 6)),
+                np.empty((3, max(nm, gap.size))), np.empty((2, KMAX + 2)))
+    rows = (np.empty(nrm, dtype=np.int64), np.empty(nrm, dtype=np.int64))
+    return _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, tr_to, gap, side, kst, dash,
+                 pt0, pt1, pconst, pslope, pamp, pOm, pphase, T_end, tol_h, xtol, max_events, budget, fc, ic, eta,
+                 deta, own_e, own_d, toggles, phase, held, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t,
+                 ev_kind, ev_c, ev_v, ev_d, jumps, vectors, matrices, rows)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, tr_to, gap, side, kst, dash,
+          pt0, pt1, pconst, pslope, pamp, pOm, pphase,
+          T_end, tol_h, xtol, max_events, budget, fc, ic, eta, deta, own_e, own_d, toggles, phase, held,
+          seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps,
+          vectors, matrices, rows):  # pragma: no cover - compiled
+    """The loop of :func:`run`, on the scratch arrays it made; no reference counting (:mod:`._jit`)."""
+    nm = eta.size
     nc = gap.size
     nrm = 2 * nc
-    h0, dh0, P, lA, lB, lD, lE, AL = workspace(nm)
-    V = np.empty((nrm, nm))
-    U = np.empty((nrm, nm))
-    base = np.empty(nrm)
-    rowc = np.empty(nrm, dtype=np.int64)
-    rowk = np.empty(nrm, dtype=np.int64)
-    VH = np.empty((nrm, nm))
-    VD = np.empty((nrm, nm))
-    WH = np.empty((nrm, nm))
-    WD = np.empty((nrm, nm))
-    PV = np.empty((nrm, NP))
-    g = np.empty(nrm)
-    dg = np.empty(nrm)
-    gb = np.empty(nrm)
-    dgb = np.empty(nrm)
-    M = np.empty(nrm)
-    dvec = np.empty(KMAX + 1)
-    mag = np.empty(KMAX + 1)
-    alpha = np.empty(nm)
-    stack = np.empty((96, 6))
-    work = np.empty((3, max(nm, nc)))
+    h0, dh0, lA, lB, lD, lE, alpha, base, g, dg, gb, dgb, M, dvec, mag = vectors
+    P, AL, V, U, VH, VD, WH, WD, PV, stack, work, dwork = matrices
+    rowc, rowk = rows
     evals = 0
     while True:
         if ic[I_PENDING] >= 0:
@@ -341,24 +361,19 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
         if t >= T_end or kp >= pt0.size:
             return DONE
         s = ic[I_SLOT]
+        reg_s, dec_s, wdh_s, om_s = reg[s], dec[s], wdh[s], om[s]
         Om, phi = segment_setup(s, kp, t, eta, deta, reg, dec, om, LW[:, 0], LW[:, 1], CW[:, 0], CW[:, 1],
                                 LW[:, 2], LW[:, 3], smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase,
                                 h0, dh0, P, lA, lB, lD, lE, AL)
         nr = contactor_rows(s, smask[s], RW, gap, side, kst, dash, phase, V, U, base, rowc, rowk)
         t_end = min(pt1[kp], T_end)
         tau_end = t_end - t
-        project(V, U, base, dec[s], om[s], h0, dh0, P, AL, Om, VH, VD, PV, nr)
+        project(V, U, base, dec_s, om_s, h0, dh0, P, AL, Om, VH, VD, PV, nr)
         resume = ic[I_RESUME] == 1
-        for r in range(nr):
-            pv, pd = particular(PV[r], 0.0, Om, phi)
-            g[r] = base[r] + pv
-            dg[r] = pd
-            for n in range(nm):
-                g[r] += VH[r, n]
-                dg[r] += VD[r, n]
-        if not resume and nr > 0:
-            r_bad = _judge_start(ic, fc, g, nr, rowc, V, U, base, dec[s], om[s], eta, deta, lA, lB, lD, lE, AL,
-                                 Om, phi, toggles, tol_h, dvec, mag)
+        touching = _openings(PV, VH, VD, base, nr, Om, phi, tol_h, g, dg)
+        if touching and not resume:
+            r_bad = _judge_start(ic, fc, g, nr, rowc, V, U, base, dec_s, om_s, eta, deta, lA, lB, lD, lE, AL,
+                                 Om, phi, toggles, tol_h, dvec, mag, dwork)
             if r_bad >= 0:
                 c = rowc[r_bad]
                 if rowk[r_bad] == ROW_PHASE:
@@ -381,13 +396,13 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
                 M[r] = held[2 * nrm + r]
             ic[I_RESUME] = 0
         else:
-            curvature_bound(VH[:nr], VD[:nr], dec[s], om[s], PV[:nr], Om, tau_end, M[:nr])
+            curvature_bound(VH[:nr], VD[:nr], dec_s, om_s, PV[:nr], Om, tau_end, M[:nr])
         wmax = 0.0
         for n in range(nm):
-            wmax = max(wmax, om[s, n])
+            wmax = max(wmax, om_s[n])
         dmin = math.pi / (4.0 * wmax) if wmax > 0.0 else tau_end
         tau_e, ch, used = scan(tau0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h, used0,
-                               budget - evals, stack, reg[s], dec[s], wdh[s], om[s], VH[:nr], VD[:nr], base[:nr],
+                               budget - evals, stack, reg_s, dec_s, wdh_s, om_s, VH[:nr], VD[:nr], base[:nr],
                                PV[:nr], Om, phi, WH[:nr], WD[:nr])
         evals += used - used0
         ic[I_EVALS] += used - used0
@@ -407,10 +422,11 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
             seg_t1[i] = te
             seg_s[i] = s
             seg_k[i] = kp
-            copy_into(seg_eta[i], eta)
-            copy_into(seg_deta[i], deta)
+            for n in range(nm):
+                seg_eta[i, n] = eta[n]
+                seg_deta[i, n] = deta[n]
             ic[I_NSEG] = i + 1
-            state_at(te - t, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, eta, deta)
+            state_at(te - t, reg_s, dec_s, wdh_s, om_s, h0, dh0, P, Om, phi, eta, deta)
         fc[F_T] = te
         if ch >= 0:
             c = rowc[ch]

@@ -232,8 +232,8 @@ def pack_key(
 class _Records:
     """Growing record arrays of segments, events and energy jumps."""
 
-    def __init__(self, nm: int) -> None:
-        n = 64
+    def __init__(self, nm: int, n: int = 64) -> None:
+        self.taken = False  # the solution holds views of these arrays: not to be reused
         self.seg_t0 = np.empty(n)
         self.seg_t1 = np.empty(n)
         self.seg_s = np.empty(n, dtype=np.int64)
@@ -262,17 +262,25 @@ _SPARE = threading.local()  # record arrays of this thread's last run, reused by
 
 
 @contextlib.contextmanager
-def _records(nm: int) -> Iterator[_Records]:
-    """Record arrays for a run: this thread's spare ones (grown by earlier runs), or new ones when in use."""
+def _records(nm: int, n_pieces: int) -> Iterator[_Records]:
+    """Record arrays for a run: this thread's spare ones (grown by earlier runs), or new ones when in use.
+
+    A run has at least one segment per load piece: records for a long load are made that large at
+    once (an eighth more for the events), and the solution takes them without a copy (:func:`_solution`).
+    """
     rec = getattr(_SPARE, "rec", None)
-    if rec is None or rec.seg_eta.shape[1] != nm:
-        rec = _Records(nm)
+    need = n_pieces + n_pieces // 8 + 64
+    if rec is None or rec.seg_eta.shape[1] != nm or (n_pieces > _TAKE and rec.seg_t0.size < need):
+        rec = _Records(nm, need if n_pieces > _TAKE else 64)
     else:
         _SPARE.rec = None  # in use (a run started from a callback of this one gets its own)
     try:
         yield rec
     finally:
-        _SPARE.rec = rec
+        _SPARE.rec = None if rec.taken else rec
+
+
+_TAKE = 1 << 14  # segments from which the solution takes the record arrays instead of copying them
 
 
 _PIECES: weakref.WeakKeyDictionary[Excitation, dict[float, tuple[np.ndarray, ...]]] = weakref.WeakKeyDictionary()
@@ -368,7 +376,7 @@ def integrate(
     # place of a scan stopped at a checkpoint
     carry = (eta, deta, eta.copy(), deta.copy(), np.zeros(nc1, dtype=np.int64), np.zeros(nc1, dtype=np.int64),
              np.zeros(3 * max(2 * len(contactors), 1)))
-    with _records(nm) as rec:
+    with _records(nm, int(pcs[0].size)) as rec:
         return _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress)
 
 
@@ -406,10 +414,14 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solutio
         warnings.append(projection_warning(int(ic[_loop.I_WARN_N]), njump, options.modes, int(ic[_loop.I_WARN_C]),
                                            float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE]),
                                            float(fc[_loop.F_WARN_T])))
+    rec.taken = nseg > _TAKE and 2 * nseg > rec.seg_t0.size  # large and mostly used: no copy
+
+    def out(a: np.ndarray) -> np.ndarray:
+        return a[:nseg] if rec.taken else a[:nseg].copy()
+
     return Solution(
-        t0=rec.seg_t0[:nseg].copy(), t1=rec.seg_t1[:nseg].copy(), slot=rec.seg_s[:nseg].copy(),
-        piece=rec.seg_k[:nseg].copy(), eta0=rec.seg_eta[:nseg].copy(), deta0=rec.seg_deta[:nseg].copy(),
-        packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=None,
+        t0=out(rec.seg_t0), t1=out(rec.seg_t1), slot=out(rec.seg_s), piece=out(rec.seg_k), eta0=out(rec.seg_eta),
+        deta0=out(rec.seg_deta), packed=pk, pieces=pcs, contactor_arrays=con, contactors=contactors, events=None,
         energy_jumps=rec.jumps[:njump].copy(), event_penetrations=rec.ev_d[:nev].copy(), status=code,
         message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
