@@ -49,6 +49,7 @@ import numpy as np
 from ._jit import njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "kernel", "setup", "segment_setup", "state_at",
+           "mode_state", "kernels_into", "state_from",
            "project", "integral_of", "derivatives", "curvature_bound", "jerk_bound", "workspace", "copy_into",
            "ipow"]
 
@@ -148,13 +149,37 @@ def setup(reg, a, om, load_A, load_B, load_D, load_E, Om, phi, eta0, deta0, h0, 
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def mode_state(eC, eS, a, o, h, dh):  # pragma: no cover - compiled
+    """A homogeneous solution and its rate from its kernels and its initial value ``h`` and slope ``dh``."""
+    return (eC + a * eS) * h + eS * dh, -o * o * eS * h + (eC - a * eS) * dh
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover - compiled
     """Coordinates ``e`` and rates ``d`` at ``tau`` (filled in place)."""
     for n in range(om.size):
         eC, eS = kernel(reg[n], a[n], w[n], tau)
         pv, pd = particular(P[n], tau, Om, phi)
-        e[n] = (eC + a[n] * eS) * h0[n] + eS * dh0[n] + pv
-        d[n] = -om[n] * om[n] * eS * h0[n] + (eC - a[n] * eS) * dh0[n] + pd
+        zh, dzh = mode_state(eC, eS, a[n], om[n], h0[n], dh0[n])
+        e[n] = zh + pv
+        d[n] = dzh + pd
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def kernels_into(tau, reg, a, w, kc, ks):  # pragma: no cover - compiled
+    """Every coordinate's kernels ``(e_C, e_S)`` at ``tau`` into ``kc, ks``."""
+    for n in range(a.size):
+        kc[n], ks[n] = kernel(reg[n], a[n], w[n], tau)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def state_from(tau, kc, ks, a, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover - compiled
+    """:func:`state_at` with the kernels at ``tau`` given (:func:`kernels_into`): the same numbers."""
+    for n in range(om.size):
+        pv, pd = particular(P[n], tau, Om, phi)
+        zh, dzh = mode_state(kc[n], ks[n], a[n], om[n], h0[n], dh0[n])
+        e[n] = zh + pv
+        d[n] = dzh + pd
 
 
 @njit(cache=True, nogil=True, _nrt=False)

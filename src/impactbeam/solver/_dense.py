@@ -42,7 +42,7 @@ ROW0 = np.int64(0)  # int64 values, not literals: one compiled specialisation of
 ONE_ROW = np.int64(1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def first_segment(t1, lo):  # pragma: no cover - compiled
     """``max(searchsorted(t1, lo) - 1, 0)``: the segment before the first one ending at or after ``lo``.
 
@@ -59,7 +59,7 @@ def first_segment(t1, lo):  # pragma: no cover - compiled
     return max(left - 1, 0)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, smask, gap, side, kst,
            pt0, pconst, pslope, pamp, pOm, pphase, ws):  # pragma: no cover - compiled
     """Closed form of segment ``j`` (:func:`~impactbeam.solver._closed.segment_setup`) into the workspace ``ws``."""
@@ -69,7 +69,7 @@ def _setup(j, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, om, LW, CW, sma
                          pOm, pphase, h0, dh0, P, lA, lB, lD, lE, AL)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def slot_row(gen, G, r, rate, v, u):  # pragma: no cover - compiled
     """The modal-frame row ``r . (eta + rate eta')`` as coefficients ``(v, u)`` on a slot's ``(z, z' - alpha)``."""
     nm = r.size
@@ -103,14 +103,22 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
     dissipated by the engaged contactors' dashpots).
     """
     nm = seg_eta.shape[1]
-    ws = workspace(nm)
+    vectors = (np.empty(nm), np.empty(nm), np.empty(nm), np.empty(nm), np.empty(nm))
+    _sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, want_modal, want_energy, seg_t0,
+            seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, omo, Wc, LW, CW, gen, G, Cd, pw, pre, smask, gap,
+            side, kst, dash, pt0, pconst, pslope, pamp, pOm, pphase, workspace(nm), vectors)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, want_modal, want_energy,
+            seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, omo, Wc, LW, CW, gen, G, Cd, pw, pre,
+            smask, gap, side, kst, dash, pt0, pconst, pslope, pamp, pOm, pphase, ws, vectors):
+    # pragma: no cover - compiled
+    """The loop of :func:`sample` on the scratch arrays it made; no reference counting (:mod:`._jit`)."""
+    nm = seg_eta.shape[1]
     h0, dh0, P = ws[0], ws[1], ws[2]
     AL = ws[7]
-    z = np.empty(nm)
-    dz = np.empty(nm)
-    e = np.empty(nm)
-    d = np.empty(nm)
-    alpha = np.empty(nm)
+    z, dz, e, d, alpha = vectors
     cur = -1
     Om = 0.0
     phi = 0.0
@@ -172,7 +180,7 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
             energies[i, 4] = cp
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def sample_row(t, Wq, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
                kst, pt0, pconst, pslope, pamp, pOm, pphase, work):  # pragma: no cover - compiled
     """``Wq[s] . eta(t)``: one row at one time, as :func:`sample` evaluates it (``work`` from :func:`dense_work`).
@@ -180,7 +188,7 @@ def sample_row(t, Wq, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om
     The segment is the last one starting at or before ``t`` (an event time
     belongs to the segment it starts).
     """
-    ws, alpha, e, d = work[0], work[9], work[10], work[11]
+    ws, alpha, e, d, z, dz = work[0], work[9], work[10], work[11], work[13], work[14]
     h0, dh0, P = ws[0], ws[1], ws[2]
     AL = ws[7]
     left = 0
@@ -197,8 +205,6 @@ def sample_row(t, Wq, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om
                      pconst, pslope, pamp, pOm, pphase, ws)
     tau = t - seg_t0[j]
     nm = seg_eta.shape[1]
-    z = np.empty(nm)
-    dz = np.empty(nm)
     state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz)
     if gen[s]:
         alpha_at(AL, tau, Om, phi, alpha)
@@ -209,7 +215,7 @@ def sample_row(t, Wq, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om
     return acc
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _upper(t0, u0, d0, t1, u1, d1, M):  # pragma: no cover - compiled
     """Upper bound of a function on [t0, t1] from end values, slopes and ``|u''| <= M``."""
     L = t1 - t0
@@ -222,7 +228,7 @@ def _upper(t0, u0, d0, t1, u1, d1, M):  # pragma: no cover - compiled
     return U
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
     """Row 0 and its first two derivatives at ``tau`` (the second from the equation of motion)."""
     p = PV[0]
@@ -247,7 +253,7 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - 
     return u, du, ddu
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
     # pragma: no cover - compiled
     """Branch and bound for the maximum of row 0 on ``[ta, tb]`` (module docstring).
@@ -331,10 +337,10 @@ def dense_work(nm):  # pragma: no cover - compiled
     """Work arrays of :func:`extremum_query` and :func:`integral_query` for ``nm`` coordinates."""
     return (workspace(nm), np.empty((1, nm)), np.empty((1, nm)), np.zeros(1), np.empty((1, nm)), np.empty((1, nm)),
             np.empty((1, NP)), np.empty(1), np.empty(1), np.zeros(nm), np.empty(nm), np.empty(nm),
-            np.empty((128, 8)))
+            np.empty((128, 8)), np.empty(nm), np.empty(nm))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def row_ceiling(VH, VD, PV, base, reg, a, wd, L):  # pragma: no cover - compiled
     """An upper bound of row 0 of a projection on ``[0, L]``, and the magnitude it is made of.
 
@@ -363,7 +369,7 @@ def row_ceiling(VH, VD, PV, base, reg, a, wd, L):  # pragma: no cover - compiled
     return up, mag
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg_t1, seg_s, seg_k, seg_eta,
                    seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp,
                    pOm, pphase, work):  # pragma: no cover - compiled
@@ -379,7 +385,7 @@ def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg
     could not have changed that value, so the result is the same to the bit,
     only sooner.
     """
-    ws, V, U, base, VH, VD, PV, M, M3, alpha, e, d, stack = work
+    ws, V, U, base, VH, VD, PV, M, M3, alpha, e, d, stack, _, _ = work
     h0, dh0, P = ws[0], ws[1], ws[2]
     AL = ws[7]
     nm = seg_eta.shape[1]
@@ -435,7 +441,7 @@ def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg
     return best, tbest
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val, out_t,
              seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
              kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
@@ -448,7 +454,7 @@ def extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val,
             pamp, pOm, pphase, work)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def integral_query(lo, hi, Wq, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G,
                    smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, work):  # pragma: no cover
     """``int_lo^hi Wq[s] . eta dt`` over the segments, in closed form (``work`` from :func:`dense_work`)."""
@@ -477,7 +483,7 @@ def integral_query(lo, hi, Wq, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, 
     return total
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen,
              G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
     """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form."""

@@ -35,9 +35,9 @@ import math
 import numpy as np
 from ._jit import njit
 
-from ._closed import EPS, curvature_bound_at, derivatives, kernel, particular
+from ._closed import EPS, curvature_bound_at, derivatives, kernel, mode_state, particular
 
-__all__ = ["row_at", "brent", "safe_step", "first_event", "scan", "departure"]
+__all__ = ["row_at", "row_from", "brent", "safe_step", "first_event", "scan", "departure"]
 
 RTOL = 4.0 * EPS
 _STACK = 96
@@ -55,8 +55,22 @@ def row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cove
     dg = pd
     for n in range(om.size):
         eC, eS = kernel(reg[n], a[n], w[n], tau)
-        g += (eC + a[n] * eS) * VH[c, n] + eS * VD[c, n]
-        dg += -om[n] * om[n] * eS * VH[c, n] + (eC - a[n] * eS) * VD[c, n]
+        zh, dzh = mode_state(eC, eS, a[n], om[n], VH[c, n], VD[c, n])
+        g += zh
+        dg += dzh
+    return g, dg
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def row_from(c, tau, kc, ks, a, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
+    """:func:`row_at` with the kernels at ``tau`` given (:func:`~impactbeam.solver._closed.kernels_into`)."""
+    pv, pd = particular(PV[c], tau, Om, phi)
+    g = base[c] + pv
+    dg = pd
+    for n in range(om.size):
+        zh, dzh = mode_state(kc[n], ks[n], a[n], om[n], VH[c, n], VD[c, n])
+        g += zh
+        dg += dzh
     return g, dg
 
 
@@ -229,7 +243,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
 
 @njit(cache=True, nogil=True, _nrt=False)
 def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, stack, reg, a, w, om, VH, VD, base, PV,
-         Om, phi, work_h, work_d):
+         Om, phi, work_h, work_d, kc, ks):
     # pragma: no cover - compiled
     """Advance from ``tau0`` to the first switching event before ``tau_end``.
 
@@ -242,7 +256,8 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
     never stopped). Returns ``(tau, c, n)``: the event time and row, ``c = -1``
     if none up to ``tau_end``, or ``c = -2`` when ``budget`` more steps were
     taken first (``tau`` is then the point reached, every row proven
-    consistent up to it); ``n`` the steps of the segment so far.
+    consistent up to it); ``n`` the steps of the segment so far. ``kc, ks``:
+    the kernels at ``tau_end`` (:func:`~impactbeam.solver._closed.kernels_into`).
     """
     nc = g.size
     tau = tau0
@@ -265,7 +280,10 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
         if tb <= tau:
             tb = tau_end
         for c in range(nc):
-            gb[c], dgb[c] = row_at(c, tb, reg, a, w, om, VH, VD, base, PV, Om, phi)
+            if tb == tau_end:  # the kernels at the segment's end are given
+                gb[c], dgb[c] = row_from(c, tb, kc, ks, a, om, VH, VD, base, PV, Om, phi)
+            else:
+                gb[c], dgb[c] = row_at(c, tb, reg, a, w, om, VH, VD, base, PV, Om, phi)
         used += 1
         best = np.inf
         which = -1

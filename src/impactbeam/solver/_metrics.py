@@ -44,7 +44,7 @@ MIN_RESPONSE, MAX_PENETRATION, N_EVENTS, ENERGY_RESIDUAL = 6, 7, 8, 9
 IMPACT = 1  # ev_kind of an impact (0: a rebound)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def pairwise_sum(x, n):  # pragma: no cover - compiled
     """``numpy.sum(x[:n])`` to the bit: NumPy's pairwise summation (blocks of 128, eight accumulators)."""
     if n < 8:
@@ -76,7 +76,7 @@ def pairwise_sum(x, n):  # pragma: no cover - compiled
     return pairwise_sum(x, n2) + pairwise_sum(x[n2:], n - n2)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def release_loss_sum(ev_c, ev_kind, ev_d, nev, dash, kst, work):  # pragma: no cover - compiled
     """Sum of the energies the contactors' dashpots take at their switches (``release_losses``), NumPy's order.
 
@@ -93,7 +93,7 @@ def release_loss_sum(ev_c, ev_kind, ev_d, nev, dash, kst, work):  # pragma: no c
     return pairwise_sum(work, m)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def contact_rows(ev_t, ev_kind, ev_c, nev, n_contactors, t_end, rc, ra, rb, rbe):  # pragma: no cover - compiled
     """Contact intervals with a positive clipped length: contactor, start, end (inf: still engaged), clipped end.
 
@@ -125,7 +125,7 @@ def contact_rows(ev_t, ev_kind, ev_c, nev, n_contactors, t_end, rc, ra, rb, rbe)
     return n
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def first_contact(ev_t, ev_kind, ev_c, nev, t_max, out):  # pragma: no cover - compiled
     """Contact intervals of contactor 0: ``out = (count, first start, free duration, start and end of the
     first interval beginning at or after t_max)`` (NaN where there is none)."""
@@ -173,7 +173,7 @@ def first_contact(ev_t, ev_kind, ev_c, nev, t_max, out):  # pragma: no cover - c
     out[4] = b_after
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def assemble(out, nev, top, t_top, low, energy_residual, deepest, n_rows, rc, ra, peaks, contact, gap0, peak_after):
     # pragma: no cover - compiled
     """The scalar metrics (order :data:`SCALARS`, NaN for undefined) from what the queries found.
