@@ -271,3 +271,50 @@ def test_a_sweep_of_a_random_load_stores_what_each_run_gives(tmp_path):
             stored = ds.sel({"solver.end_time": end, "excitation.scale": scale})
             for key in METRIC_UNITS:
                 assert _same(m[key], float(stored[key].values)), (end, scale, key)
+
+
+@pytest.mark.parametrize("kind", ["compiled", "interpreted"])
+def test_kernels_given_at_a_segment_end_give_the_bits_of_kernels_computed_there(kind):
+    # The event loop computes the kernels at a segment's end once per slot and segment length and hands
+    # them to the scan's last step (row_from) and to the state update (state_from): every regime must give
+    # exactly what row_at and state_at compute there, or a run would depend on which path it took.
+    K = kernels.compiled() if kind == "compiled" else kernels.interpreted()
+    rng = np.random.default_rng(3)
+    reg = np.array([0, 0, 1, 1, 2, 2], dtype=np.int64)  # under-, critically and over-damped; a rigid mode (1, 0)
+    a = np.array([0.0, 12.0, 40.0, 0.0, 90.0, 5.0])
+    om = np.array([300.0, 2000.0, 40.0, 0.0, 60.0, 0.0])
+    w = np.where(reg == 0, np.sqrt(np.abs(om**2 - a**2)), np.where(reg == 2, np.sqrt(np.abs(a**2 - om**2)), 0.0))
+    h0, dh0 = rng.normal(size=6), rng.normal(size=6)
+    P = rng.normal(size=(6, 8))
+    VH, VD, PV = rng.normal(size=(2, 6)), rng.normal(size=(2, 6)), rng.normal(size=(2, 8))
+    base = rng.normal(size=2)
+    for tau, Om, phi in ((1.25e-4, 0.0, 0.0), (3.7e-3, 210.0, 0.4)):
+        kc, ks = np.empty(6), np.empty(6)
+        K.kernels_into(tau, reg, a, w, kc, ks)
+        e1, d1, e2, d2 = (np.empty(6) for _ in range(4))
+        K.state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e1, d1)
+        K.state_from(tau, kc, ks, a, om, h0, dh0, P, Om, phi, e2, d2)
+        np.testing.assert_array_equal(e1, e2)
+        np.testing.assert_array_equal(d1, d2)
+        for c in range(2):
+            assert K.row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi) == \
+                K.row_from(c, tau, kc, ks, a, om, VH, VD, base, PV, Om, phi)
+
+
+@pytest.mark.filterwarnings("ignore:excitation.psd")
+def test_a_long_run_keeps_its_records_while_the_next_one_runs(monkeypatch):
+    # A long run's solution takes the engine's record arrays without a copy; the next run in the thread
+    # must then get arrays of its own, or it would overwrite the first solution's segments.
+    monkeypatch.setattr(engine, "_TAKE", 64)  # "long" from 64 segments: a 0.07 s random record has ~280
+    sc = _case3().with_values({
+        "excitation.shape": "random", "excitation.amplitude": None, "excitation.duration": None,
+        "excitation.psd": [["10 Hz", "0.05 g^2/Hz"], ["500 Hz", "0.05 g^2/Hz"]], "excitation.seed": 11,
+        "solver.end_time": 0.07,
+    })
+    first = ib.simulate(sc).solution
+    assert first.t0.size > 64 and first.eta0.base is not None  # taken, not copied
+    kept = [np.array(r, copy=True) for r in _records(first)]
+    ib.simulate(sc.with_values({"excitation.seed": 12}))
+    ib.simulate(_case3())
+    for u, v in zip(kept, _records(first)):
+        np.testing.assert_array_equal(u, v)
