@@ -96,6 +96,24 @@ def test_harmonic_miner_damage_is_f_over_n():
         assert row["life"] == pytest.approx(n_s / f, rel=1e-9)
 
 
+
+def test_fatigue_reports_its_progress_and_the_chunks_change_nothing(monkeypatch):
+    """The stress scan and the refinement report their progress (a 100 s record takes seconds per point);
+    the chunks the stress is sampled in (here 97 samples instead of 65,536) change no number."""
+    import impactbeam.statistics.fatigue as fatigue_module
+    from impactbeam.statistics import run_statistics, statistics_stages
+
+    sc = _harmonic_scenario()
+    whole = fatigue_statistics(ib.simulate(sc), sc.fatigue)
+    monkeypatch.setattr(fatigue_module, "_CHUNK", 97)
+    res = ib.simulate(sc)
+    seen: list[float] = []
+    out = run_statistics(res, seen.append)
+    assert out["fatigue"] == whole
+    assert statistics_stages(res) == 3  # the impacts and two fatigue points
+    assert len(seen) > 40 and seen[-1] == 3.0
+    assert all(b >= a for a, b in zip(seen, seen[1:]))  # it only moves forward
+
 def test_dirlik_against_flife():
     """Our closed form of Dirlik's damage against FLife's implementation on the same density."""
     flife = pytest.importorskip("FLife")

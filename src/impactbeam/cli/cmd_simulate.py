@@ -95,9 +95,10 @@ def simulate(
     metrics = result.metrics()
     metrics["modes"] = result.n_modes
     metrics["convergence"] = result.convergence  # computed now, so its warning is caught below
-    from ..statistics import run_statistics
+    from ..statistics import run_statistics, statistics_stages
 
-    metrics.update(run_statistics(result))  # impact statistics per contactor and, with [fatigue], fatigue
+    with progress_bar(statistics_stages(result), desc="statistics", unit="stage") as report:
+        metrics.update(run_statistics(result, report))  # impact statistics per contactor; with [fatigue], fatigue
     if sc.excitation.shape == "random":
         metrics["seed"] = sc.excitation.seed  # drawn when the scenario gives none: reported to repeat the run
     if out is not None:

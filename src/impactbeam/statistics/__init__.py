@@ -17,7 +17,7 @@ solution and events) and never runs the solver.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 from .ensemble import batch_mean, rms_from_mean_squares
 from .fatigue import cycles_to_failure, fatigue_statistics, miner_damage, rainflow_cycles, stress_turning_points
@@ -34,7 +34,7 @@ __all__ = [
     "fatigue_statistics", "stress_turning_points", "rainflow_cycles", "cycles_to_failure", "miner_damage",
     "welch_psd", "chi2_band", "spectral_moments", "rice_rate", "dirlik_range_density", "dirlik_damage_rate",
     "batch_mean", "rms_from_mean_squares", "analysis_window", "scan_times", "settling_time", "run_statistics",
-    "STATISTICS_DISPLAY",
+    "statistics_stages", "STATISTICS_DISPLAY",
 ]
 
 #: How summaries show the impact statistics: (key, label, scale, unit).
@@ -49,12 +49,21 @@ STATISTICS_DISPLAY = (
 )
 
 
-def run_statistics(result: ResultLike) -> dict[str, Any]:
+def statistics_stages(result: ResultLike) -> int:
+    """How many stages :func:`run_statistics` reports: the impacts, and each fatigue point."""
+    fatigue = getattr(getattr(result, "scenario", None), "fatigue", None)
+    return 1 + (len(fatigue.points) if fatigue is not None else 0)
+
+
+def run_statistics(result: ResultLike, progress: Callable[[float], None] | None = None) -> dict[str, Any]:
     """The statistics ``impactbeam simulate --json`` adds: impacts per contactor and, with ``[fatigue]``, fatigue.
 
     Parameters
     ----------
     result : SimulationResult
+    progress : callable, optional
+        Called with the stages done (:func:`statistics_stages` at the end;
+        fractions within a fatigue point).
 
     Returns
     -------
@@ -64,8 +73,11 @@ def run_statistics(result: ResultLike) -> dict[str, Any]:
         when the scenario has ``[fatigue]``.
     """
     imp = impact_statistics(result)
+    if progress is not None:
+        progress(1.0)
     out: dict[str, Any] = {"statistics_window": list(imp.window), "impact_statistics": imp.contactors}
     fatigue = getattr(getattr(result, "scenario", None), "fatigue", None)
     if fatigue is not None:
-        out["fatigue"] = fatigue_statistics(result, fatigue, imp.window)
+        out["fatigue"] = fatigue_statistics(result, fatigue, imp.window,
+                                            None if progress is None else (lambda done: progress(1.0 + done)))
     return out
