@@ -115,3 +115,31 @@ def test_a_sweep_into_a_pipe_reports_progress_in_whole_lines(tmp_path):
     assert "\r" not in err
     lines = [ln for ln in err.splitlines() if ln.startswith("sweep:")]
     assert lines and lines[-1].startswith("sweep: 100% (2/2 case)"), err
+
+
+def test_a_closed_progress_shows_nothing_more(capsys, monkeypatch):
+    # The convergence estimate's runs reported to the simulation's bar after it had closed: a line
+    # "simulate: 81%" came after the run had ended. A closed Progress ignores late reports.
+    import impactbeam._warnings as w
+    from impactbeam._warnings import Progress
+
+    monkeypatch.setattr(w, "LINE_EVERY", 0.0)  # every report is a line
+    with Progress(1.0, desc="simulate", unit="s", after=0.0) as report:
+        report(0.5)
+    report(0.75)
+    err = capsys.readouterr().err.splitlines()
+    assert [ln.split(" after")[0] for ln in err] == ["simulate:  50% (0.5/1 s)", "simulate:  50% (0.5/1 s)"]
+
+
+def test_the_convergence_estimate_reports_its_own_runs():
+    # The estimate repeats the run at two coarser counts; the command line shows that as its own
+    # progress ("convergence estimate"), not on the simulation's bar.
+    sc = ib.load_scenario(EXAMPLES / "case03.toml")
+    seen: list[float] = []
+    res = ib.simulate(sc, progress=seen.append)
+    n_run = len(seen)
+    conv = res.estimate_convergence(seen.append)
+    assert conv == ib.simulate(sc).convergence
+    est = seen[n_run:]
+    assert len(est) >= 2 and est[-1] == 2.0 and all(b >= a for a, b in zip(est, est[1:]))
+    assert res.estimate_convergence(seen.append) is conv and len(seen) == n_run + len(est)  # computed once

@@ -169,11 +169,12 @@ class Progress:
         self._bar: Any = None
         self._last = -math.inf
         self._shown = False
+        self._closed = False  # later reports (work that outlived its bar) are not shown
         self._interactive = _is_terminal(sys.stderr)
 
     def __call__(self, done: float) -> None:
         self._done = max(0.0, min(float(done), self.total))
-        if not self.enabled or time.monotonic() - self._start <= self.after:
+        if not self.enabled or self._closed or time.monotonic() - self._start <= self.after:
             return
         if not self._interactive:
             if time.monotonic() - self._last >= LINE_EVERY:
@@ -191,6 +192,7 @@ class Progress:
 
     def close(self) -> None:
         """The bar's last state, or the last line, is out before anything else is written."""
+        self._closed = True
         if self._bar is not None:
             self._bar.close()
             self._bar = None

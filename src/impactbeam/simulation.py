@@ -89,14 +89,15 @@ def simulate_system(
     pts_arr = _check_system(beam, contactors, excitation, initial, options, points, method)
     _check_start(start, beam, contactors, options, method, excitation)
 
-    def run(n_modes: int, *, announce: bool = True) -> SimulationResult:
+    def run(n_modes: int, *, announce: bool = True,
+            report: Callable[[float], None] | None = progress) -> SimulationResult:
         opt = options if options.modes == n_modes else dataclasses.replace(options, modes=n_modes)
         if method == "ivp":
             from .solver.reference import integrate_ivp
 
             solution: PiecewiseSolution = integrate_ivp(beam, contactors, damping, excitation, initial, opt, preload)
         else:
-            solution = integrate(beam, contactors, damping, excitation, initial, opt, progress,
+            solution = integrate(beam, contactors, damping, excitation, initial, opt, report,
                                  None if start is None else (start.eta, start.deta), preload)
         if announce:
             for text in solution.warnings:
@@ -104,7 +105,8 @@ def simulate_system(
         info = {"modes": n_modes, "time_step": opt.time_step, "end_time": opt.end_time, "method": method,
                 "basis": opt.basis}
         return SimulationResult(solution, pts_arr, beam, contactors, n_modes, opt.time_step, opt.end_time, name,
-                                info, rerun=functools.partial(run, announce=False), tolerance=opt.tolerance)
+                                info, rerun=functools.partial(run, announce=False, report=None),
+                                tolerance=opt.tolerance)
 
     if options.modes != "auto":
         return run(int(options.modes))

@@ -94,7 +94,10 @@ def simulate(
         result = run(sc, progress=report)
     metrics = result.metrics()
     metrics["modes"] = result.n_modes
-    metrics["convergence"] = result.convergence  # computed now, so its warning is caught below
+    from ..solver.convergence import coarser_counts
+
+    with progress_bar(max(len(coarser_counts(result.n_modes)), 1), desc="convergence estimate", unit="run") as report:
+        metrics["convergence"] = result.estimate_convergence(report)  # now, so that its warning is caught below
     from ..statistics import run_statistics, statistics_stages
 
     with progress_bar(statistics_stages(result), desc="statistics", unit="stage") as report:

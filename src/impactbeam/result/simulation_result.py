@@ -145,14 +145,25 @@ class SimulationResult:
         self.__dict__["_impact_convergence"] = None if peak_forces is None else np.asarray(peak_forces, dtype=float)
         self.__dict__["_convergence_counts"] = tuple(int(c) for c in counts)
 
-    def _estimate(self) -> None:
-        """Run the coarser counts and record the estimate (:mod:`impactbeam.solver.convergence`)."""
-        from ..solver.convergence import coarser_counts, estimate
+    def estimate_convergence(self, progress: Callable[[float], None] | None = None) -> dict[str, float] | None:
+        """:attr:`convergence`, computed now if it is not yet (the run again at two smaller counts).
 
-        counts = coarser_counts(self.n_modes)
-        coarse = [self.rerun(c).metrics() for c in counts]  # type: ignore[misc]
-        metrics, peaks = estimate(self.metrics(), coarse)
-        self.set_convergence(metrics, peaks, counts)
+        Parameters
+        ----------
+        progress : callable, optional
+            Called with the re-runs done (:func:`~impactbeam.solver.convergence.estimate_by_reruns`).
+        """
+        if "_convergence" not in self.__dict__:
+            from .._warnings import emit_user_level_warning as warn
+            from ..solver.convergence import estimate_by_reruns
+
+            if self.rerun is None or self.n_modes <= 1:
+                return None
+            self.set_convergence(*estimate_by_reruns(self.metrics(), self.rerun, self.n_modes, self.end_time,
+                                                     progress))
+            if not self.converged:
+                warn(self.warnings[-1])
+        return self.__dict__["_convergence"]
 
     @property
     def convergence(self) -> dict[str, float] | None:
@@ -165,15 +176,7 @@ class SimulationResult:
         where it does not: :mod:`impactbeam.solver.convergence`.
         None when it cannot be computed (one mode, or a result without a re-run).
         """
-        if "_convergence" not in self.__dict__:
-            from .._warnings import emit_user_level_warning as warn
-
-            if self.rerun is None or self.n_modes <= 1:
-                return None
-            self._estimate()
-            if not self.converged:
-                warn(self.warnings[-1])
-        return self.__dict__["_convergence"]
+        return self.estimate_convergence()
 
     @property
     def impact_convergence(self) -> np.ndarray | None:

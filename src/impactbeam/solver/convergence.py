@@ -47,14 +47,15 @@ count would.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 __all__ = [
-    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "ConvergenceStudy", "coarser_counts", "estimate", "impact_changes", "relative_changes",
+    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "ConvergenceStudy", "coarser_counts", "estimate", "estimate_by_reruns",
+    "impact_changes", "relative_changes",
     "worst",
 ]
 
@@ -193,6 +194,43 @@ def estimate(new: Mapping[str, Any], coarser: Sequence[Mapping[str, Any]]) -> tu
         with np.errstate(divide="ignore", invalid="ignore"):
             peaks[at] = np.maximum(peaks[at], np.where(force[at] > 0, np.minimum(1.0, carried / force[at]), 0.0))
     return metrics, peaks
+
+
+def estimate_by_reruns(metrics: Mapping[str, Any], rerun: Callable[..., Any], n_modes: int, end_time: float,
+                       progress: Callable[[float], None] | None = None
+                       ) -> tuple[dict[str, float], np.ndarray, tuple[int, ...]]:
+    """:func:`estimate` of a run with ``n_modes`` modes against its re-runs at :func:`coarser_counts`.
+
+    Parameters
+    ----------
+    metrics : mapping
+        The run's own metrics (with its per-impact table).
+    rerun : callable
+        ``rerun(n)`` repeats the run with ``n`` modes (``rerun(n, report=f)``
+        with a progress callback ``f(t)`` of the simulated time when
+        ``progress`` is given).
+    n_modes : int
+    end_time : float, [s]
+    progress : callable, optional
+        Called with the re-runs done so far (fractions within one by its
+        simulated time).
+
+    Returns
+    -------
+    changes : dict
+    peak_changes : ndarray
+    counts : tuple of int
+    """
+    counts = coarser_counts(n_modes)
+    coarse = []
+    for i, c in enumerate(counts):
+        if progress is None:
+            res = rerun(c)
+        else:
+            res = rerun(c, report=lambda t, i=i: progress(i + t / end_time))
+        coarse.append(res.metrics())
+    changes, peaks = estimate(metrics, coarse)
+    return changes, peaks, counts
 
 
 def worst(changes: Mapping[str, float]) -> tuple[str, float]:
