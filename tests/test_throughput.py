@@ -318,3 +318,27 @@ def test_a_long_run_keeps_its_records_while_the_next_one_runs(monkeypatch):
     ib.simulate(_case3())
     for u, v in zip(kept, _records(first)):
         np.testing.assert_array_equal(u, v)
+
+
+
+@pytest.mark.filterwarnings("ignore:excitation.psd")
+def test_a_batch_solution_handed_to_case_done_survives_the_next_cases(monkeypatch):
+    # The batch reuses one set of record arrays for all its cases: the solution it hands to case_done
+    # must be a copy even when it is long (only a single run's own records may be taken).
+    from impactbeam.solver.batch import integrate_batch
+
+    monkeypatch.setattr(engine, "_TAKE", 64)
+    base = _case3().with_values({
+        "excitation.shape": "random", "excitation.amplitude": None, "excitation.duration": None,
+        "excitation.psd": [["10 Hz", "0.05 g^2/Hz"], ["500 Hz", "0.05 g^2/Hz"]], "solver.end_time": 0.07,
+    })
+    scs = [base.with_values({"excitation.seed": seed}) for seed in (21, 22)]
+    kept = []
+    with kernels.forced("compiled"):
+        integrate_batch(base.beam, [s.contactors for s in scs], base.damping, [s.excitation for s in scs],
+                        base.initial, [s.solver for s in scs], point=base.beam.length, sign=1.0,
+                        case_done=lambda j, sol: kept.append(sol))
+        alone = ib.simulate(scs[0]).solution
+    assert kept[0].t0.size > 64
+    for u, v in zip(_records(alone), _records(kept[0])):
+        np.testing.assert_array_equal(u, v)

@@ -401,10 +401,11 @@ def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, p
             break
     if progress is not None:
         progress(float(fc[_loop.F_T]))
-    return _solution(pk, contactors, options, pcs, con, fc, ic, rec, status)
+    return _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take=True)
 
 
-def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solution:
+def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take: bool = False) -> Solution:
+    """The solution in ``rec``: copied, or with ``take`` (records no later run writes) its large arrays taken."""
     nseg, nev, njump = int(ic[_loop.I_NSEG]), int(ic[_loop.I_NEV]), int(ic[_loop.I_NJUMP])
     t_stop = float(fc[_loop.F_T])
     code = 1 if status == _loop.CHATTER else 0
@@ -414,7 +415,7 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status) -> Solutio
         warnings.append(projection_warning(int(ic[_loop.I_WARN_N]), njump, options.modes, int(ic[_loop.I_WARN_C]),
                                            float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE]),
                                            float(fc[_loop.F_WARN_T])))
-    rec.taken = nseg > _TAKE and 2 * nseg > rec.seg_t0.size  # large and mostly used: no copy
+    rec.taken = take and nseg > _TAKE and 2 * nseg > rec.seg_t0.size  # large and mostly used: no copy
 
     def out(a: np.ndarray) -> np.ndarray:
         return a[:nseg] if rec.taken else a[:nseg].copy()
