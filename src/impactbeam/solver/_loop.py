@@ -431,9 +431,8 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
             seg_t1[i] = te
             seg_s[i] = s
             seg_k[i] = kp
-            for n in range(nm):
-                seg_eta[i, n] = eta[n]
-                seg_deta[i, n] = deta[n]
+            copy_into(seg_eta[i], eta)  # a view costs nothing here: no reference counting
+            copy_into(seg_deta[i], deta)
             ic[I_NSEG] = i + 1
             if ch == -1:  # te - t = tau_end: its kernels are at hand
                 state_from(tau_end, kc, ks, dec_s, om_s, h0, dh0, P, Om, phi, eta, deta)
