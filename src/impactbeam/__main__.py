@@ -1,6 +1,6 @@
 """``python -m impactbeam``: the same command line as the ``impactbeam`` script."""
 
-from .cli import main
+from .cli import console_main
 
 if __name__ == "__main__":  # pragma: no branch
-    main(prog_name="impactbeam")
+    console_main()

@@ -23,7 +23,7 @@ from types import ModuleType
 
 from .exceptions import ImpactBeamError
 
-__all__ = ["EXTRAS", "MissingDependencyError", "require"]
+__all__ = ["EXTRAS", "MissingDependencyError", "require", "check_installed"]
 
 #: The extra that provides each optional top-level package.
 EXTRAS: dict[str, str] = {
@@ -78,14 +78,46 @@ def require(module: str, extra: str | None = None, *, feature: str | None = None
         :class:`ImportError` and an :class:`~impactbeam.exceptions.ImpactBeamError`,
         so the command line prints it as one ``error:`` line (exit status 1).
     """
-    top = module.split(".")[0]
-    extra = extra or EXTRAS.get(top)
     try:
         return importlib.import_module(module)
     except ImportError as exc:
-        what = feature or _PURPOSE.get(extra or "", "this feature")
-        hint = f'pip install "impactbeam[{extra}]"' if extra else f"pip install {top}"
-        raise MissingDependencyError(
-            f"{what} needs the optional package {top!r}, which is not installed "
-            f"({type(exc).__name__}: {exc}); install it with: {hint}"
-        ) from exc
+        raise _missing(module, extra, feature, f"{type(exc).__name__}: {exc}") from exc
+
+
+def check_installed(module: str, extra: str | None = None, *, feature: str | None = None) -> None:
+    """Raise :func:`require`'s error if ``module`` is not installed, without importing it.
+
+    For a check before any work of a package a run may not import at all
+    (Dask's scheduler when the sweep runs on local processes): finding the
+    module costs a file lookup, importing it tenths of a second.
+
+    Parameters
+    ----------
+    module, extra, feature
+        As for :func:`require`.
+
+    Raises
+    ------
+    MissingDependencyError
+        No installed package provides ``module``.
+    """
+    import importlib.util
+
+    try:
+        found = importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError) as exc:  # a parent package missing, or blocked in sys.modules
+        found = False
+        reason = f"{type(exc).__name__}: {exc}"
+    else:
+        reason = f"no module named {module!r}"
+    if not found:
+        raise _missing(module, extra, feature, reason)
+
+
+def _missing(module: str, extra: str | None, feature: str | None, reason: str) -> MissingDependencyError:
+    top = module.split(".")[0]
+    extra = extra or EXTRAS.get(top)
+    what = feature or _PURPOSE.get(extra or "", "this feature")
+    hint = f'pip install "impactbeam[{extra}]"' if extra else f"pip install {top}"
+    return MissingDependencyError(
+        f"{what} needs the optional package {top!r}, which is not installed ({reason}); install it with: {hint}")

@@ -29,9 +29,10 @@ from . import (
     cmd_sweep,
     cmd_validate,
 )
-from ._group import Interrupted, fail, handle_errors, load_with_overrides, main, take_warnings, warning_lines
+from ._group import (Interrupted, console_main, fail, handle_errors, load_with_overrides, main, take_warnings,
+                     warning_lines)
 
-__all__ = ["main", "handle_errors", "take_warnings", "warning_lines", "load_with_overrides", "Interrupted", "fail"]
+__all__ = ["main", "console_main", "handle_errors", "take_warnings", "warning_lines", "load_with_overrides", "Interrupted", "fail"]
 
 for _command in (
     cmd_modes.modes,

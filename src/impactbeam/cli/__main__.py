@@ -1,6 +1,6 @@
 """``python -m impactbeam.cli``: the command line."""
 
-from . import main
+from . import console_main
 
 if __name__ == "__main__":  # pragma: no branch
-    main(prog_name="impactbeam")
+    console_main()

@@ -88,6 +88,12 @@ def simulate(
         require("matplotlib", "plot", feature="--plot")
         from ..plot.response import plot_result
 
+    from ..solver.kernels import active
+
+    # the run, the convergence estimate's two re-runs and the statistics' sampling: more than a short run's
+    # work, so the compiled kernels when numba's cache holds them (Case 3: 0.1 s compiled after 0.6 s to
+    # import numba and load them, against 0.8 s interpreted); else the interpreted ones (kernels.active)
+    active()
     with progress_bar(sc.solver.end_time, desc="simulate", unit="s", unit_scale=True,
                       bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s simulated "
                                  "[{elapsed}<{remaining}]") as report:

@@ -36,7 +36,7 @@ __all__ = ["sweep_command", "plot_command"]
 @click.option("--scheduler", "scheduler", default=None, metavar="ADDRESS",
               help="Use a running Dask scheduler (e.g. tcp://127.0.0.1:8786) and its workers.")
 @click.option("--batch-size", "batch_size", type=int, default=None, metavar="B",
-              help="Cases per task and per Zarr chunk [default: about 32 batches, at most 100 cases each].")
+              help="Cases per task and per Zarr chunk [default: about 16 batches, at most 1,000 cases each].")
 @click.option("--on-error", "on_error", type=click.Choice(["record", "raise"]), default="record",
               show_default=True, help="record: a failed case is stored with its message; raise: stop.")
 @click.option("--no-progress", "no_progress", is_flag=True, help="No progress bar.")

@@ -7,14 +7,15 @@ import os
 import signal
 import sys
 import threading
+from functools import partial
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from .._io import WriteError, check_writable, write_error
-from .._optional import require
+from .._optional import check_installed, require
 from .._warnings import Progress
 from ..exceptions import ImpactBeamError, ParameterError, SimulationError
 if TYPE_CHECKING:
@@ -26,12 +27,11 @@ from .batches import (
     _error_message,
     _make_batch,
     _regions,
-    default_batch_size,
     run_batch,
 )
 from .parse import load_sweep, parse_sweep
 from .spec import FAILED, NOT_RUN, SweepSpec
-from .store import _StoreLock, _create_store, _open_existing, statistic_names
+from .store import StoreMaker, _StoreLock, _open_existing, open_result, quiet_consolidation, statistic_names
 
 log = logging.getLogger(__name__)
 
@@ -59,19 +59,27 @@ class SweepRun:
     Attributes
     ----------
     dataset : xarray.Dataset
-        The results (lazily read from the store, or in memory without ``out``).
+        The results (lazily read from the store, opened on first use, or in
+        memory without ``out``).
     n_cases, computed, skipped, failed : int
         All cases; cases run now; cases already done in the store (resume);
         cases that failed in this run.
     out : Path or None
     """
 
-    dataset: Any
+    opener: Any = field(repr=False)
     n_cases: int
     computed: int
     skipped: int
     failed: int
     out: Path | None
+
+    @property
+    def dataset(self) -> xr.Dataset:
+        """The results (opened from the store on first use: the command line never needs them)."""
+        if not hasattr(self, "_dataset"):
+            self._dataset = self.opener()
+        return self._dataset
 
 
 class _SignalGuard:
@@ -188,8 +196,8 @@ def run_sweep(
     on_error : {"record", "raise"}
         Record a failed case (status -1) or raise.
     """
-    for name in ("zarr", "dask", "distributed"):  # before any work: one clear message
-        require(name, "sweep", feature="parameter sweeps")
+    for name in ("zarr", "dask", "distributed"):  # before any work: one clear message (found, not imported)
+        check_installed(name, "sweep", feature="parameter sweeps")
     spec = _as_spec(spec_or_path)
     if on_error not in ("record", "raise"):
         raise ParameterError(f'on_error: must be "record" or "raise", got {on_error!r}')
@@ -199,7 +207,7 @@ def run_sweep(
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise ParameterError(f"batch_size: must be a positive integer, got {batch_size!r}")
     out_path = Path(out) if out is not None else None
-    chunk = _chunk_shape(spec, batch_size or default_batch_size(spec.n_cases))
+    chunk = _chunk_shape(spec, batch_size or spec.default_batch())
     spec.check_memory(int(np.prod(chunk)))
     if out_path is None:
         _check_in_memory(spec)
@@ -242,16 +250,19 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
     """:func:`run_sweep` once the store is ours."""
     fresh = not (out_path is not None and out_path.exists()
                  and not (out_path.is_dir() and not any(out_path.iterdir())))
-    local = None
+    local = maker = None
     counts = {"computed": 0, "failed": 0}
     bar = writer = None
     try:
         with _SignalGuard() as guard:
+            if fresh:  # made by a forked process (Linux) while this one runs the first batch
+                maker = StoreMaker(spec, out_path, chunk)
             if fresh and workers != 0 and scheduler is None:
                 # a new store runs every batch of this layout: the workers start on them while it is made
                 local = _LocalWorkers(workers or os.cpu_count() or 1)
                 local.start(_make_batch(spec, r, on_error) for r in _regions(spec.shape, chunk))
-            store = _create_store(spec, out_path, chunk) if fresh else _open_existing(spec, out_path)  # type: ignore[arg-type]
+            require("zarr", "sweep")  # for the writer: imported while the store's maker works
+            store = maker.result() if maker is not None else _open_existing(spec, out_path)  # type: ignore[arg-type]
             writer = _Writer(store, spec)
             chunk = tuple(writer.arrays["status"].chunks)  # the store's layout wins on resume
             # a new store has run nothing: no need to read its (possibly millions of) status chunks
@@ -289,6 +300,8 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
                     exc.total = spec.n_cases
                     raise
     finally:
+        if maker is not None:
+            maker.close()
         if local is not None:
             local.close()
         if bar is not None:
@@ -297,24 +310,15 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
             writer.close()
     log.info("sweep %s: %d cases, %d computed, %d already done, %d failed",
              spec.name, spec.n_cases, counts["computed"], skipped, counts["failed"])
-    import xarray as xr
-
-    if out_path is not None:
-        import warnings
-
+    if out_path is not None and not fresh:  # a store made before metadata was consolidated at creation
         zarr = require("zarr", "sweep")
-
-        # consolidated metadata lets xr.open_zarr(path) open the finished store without a
-        # warning; zarr 3 notes (ZarrUserWarning) that it is an extension of its format 3
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message="Consolidated metadata", category=UserWarning)
+        with quiet_consolidation():
             zarr.consolidate_metadata(store)
-    ds = xr.open_zarr(store, consolidated=False, chunks=None)
-    order = [*spec.metrics, *statistic_names(spec), "status", "message", *(["w"] if spec.histories is not None else [])]
-    ds = ds[order]  # the store lists its arrays in no particular order
+    run = SweepRun(partial(open_result, spec, store, out_path is None), spec.n_cases, counts["computed"], skipped,
+                   counts["failed"], out_path)
     if out_path is None:
-        ds = ds.load()
-    return SweepRun(ds, spec.n_cases, counts["computed"], skipped, counts["failed"], out_path)
+        run.dataset  # noqa: B018 - loaded now, from the in-memory store
+    return run
 
 
 def _worker_start() -> None:

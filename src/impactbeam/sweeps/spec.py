@@ -52,7 +52,13 @@ NOT_RUN = -2
 STATUS_CODES = {0: "reached end_time", 1: "stopped by the chattering guard", FAILED: "failed", NOT_RUN: "not yet run"}
 
 _FORMAT_VERSION = 1
-_DEFAULT_MAX_BATCH = 100
+#: Default batches: about this many, of at most :data:`_DEFAULT_MAX_BATCH` cases and, with histories, of
+#: at most :data:`_DEFAULT_BATCH_BYTES` of them. Writing a batch costs ~1.7 ms per stored variable in the
+#: sweep's process (Zarr 3, measured), ~20 ms for the ten metrics, whatever its size: as much as ~80
+#: Case 3 cases of compute, so batches of 100 cases left the workers waiting on the writer.
+_DEFAULT_BATCHES = 16
+_DEFAULT_MAX_BATCH = 1000
+_DEFAULT_BATCH_BYTES = 64e6
 #: Peak bytes per sample and parameter of a sampled design: drawing (Latin hypercube, its
 #: permutations, the inverse CDFs) and the store's coordinates; measured 67 with 2e6 samples of
 #: 2 parameters (peak RSS).
@@ -283,6 +289,13 @@ class SweepSpec:
         """SHA-256 of :meth:`canonical`: equal for sweeps that compute the same cases."""
         return hashlib.sha256(self.canonical_json.encode()).hexdigest()
 
+    def default_batch(self) -> int:
+        """:func:`default_batch_size` of this sweep (its cases, the bytes of one case's histories)."""
+        per_case = 0.0
+        if self.histories is not None:
+            per_case = 8.0 * self.history_times().size * len(self.histories.points)
+        return default_batch_size(self.n_cases, per_case)
+
     def history_times(self) -> np.ndarray:
         """The coarse time grid of the histories: 0, dt, ... up to the longest end_time."""
         if self.histories is None:
@@ -324,20 +337,30 @@ class SweepSpec:
             check_memory(n * (SAMPLE_BYTES * d + 16), f"samples: drawing {n} samples of {d} parameter"
                          f"{'s' if d != 1 else ''}", "draw fewer samples")
         if self.histories is not None:
-            batch = batch_cases or default_batch_size(self.n_cases)
+            batch = batch_cases or self.default_batch()
             per_case = 8.0 * self.history_times().size * len(self.histories.points)
             check_memory(3.0 * batch * per_case, f"outputs.histories: a batch of {batch} cases of "
                          f"{self.history_times().size} samples at {len(self.histories.points)} points",
                          "use a larger outputs.histories.time_step, fewer points or a smaller --batch-size")
 
 
-def default_batch_size(n_cases: int) -> int:
-    """Cases per batch when not given: about 32 batches, at most 100 cases each.
+def default_batch_size(n_cases: int, case_bytes: float = 0.0) -> int:
+    """Cases per batch when not given: about 16 batches, at most 1,000 cases and 64 MB of histories each.
 
     It does not depend on the number of workers, so the same sweep gives the
-    same store layout on a laptop and on a cluster.
+    same store layout on a laptop and on a cluster (give ``batch_size`` for
+    more, smaller batches on a large cluster).
+
+    Parameters
+    ----------
+    n_cases : int
+    case_bytes : float
+        Bytes of one case's histories (0 without histories).
     """
-    return max(1, min(_DEFAULT_MAX_BATCH, math.ceil(n_cases / 32)))
+    size = min(_DEFAULT_MAX_BATCH, math.ceil(n_cases / _DEFAULT_BATCHES))
+    if case_bytes > 0:
+        size = min(size, int(_DEFAULT_BATCH_BYTES // case_bytes))
+    return max(1, size)
 
 
 def _plain(v: Any) -> Any:

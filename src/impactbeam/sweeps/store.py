@@ -7,6 +7,7 @@ import json
 import os
 import shutil
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 import numpy as np
@@ -139,7 +140,11 @@ def statistic_names(spec: SweepSpec) -> tuple[str, ...]:
 
 
 def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> Any:
-    """Write the empty store (metadata and coordinates); atomic for a directory."""
+    """Write the empty store (metadata, consolidated, and coordinates); atomic for a directory.
+
+    A store's metadata never changes after this (batches write chunks only),
+    so it is consolidated here, once.
+    """
     ds, enc = _template(spec, chunk)
     if out is None:
         zarr = require("zarr", "sweep")
@@ -151,7 +156,8 @@ def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> 
     if tmp.exists():
         shutil.rmtree(tmp)
     try:
-        ds.to_zarr(str(tmp), compute=False, encoding=enc, consolidated=False)
+        with quiet_consolidation():
+            ds.to_zarr(str(tmp), compute=False, encoding=enc, consolidated=True)
         if out.exists():  # an empty directory
             out.rmdir()
         os.replace(tmp, out)
@@ -159,6 +165,123 @@ def _create_store(spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> 
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return str(out)
+
+
+@contextlib.contextmanager
+def quiet_consolidation() -> Iterator[None]:
+    """Consolidated metadata lets ``xr.open_zarr(path)`` open a store without a warning; Zarr 3 notes
+    (a UserWarning) that it is an extension of its format 3, which tells the user nothing."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Consolidated metadata", category=UserWarning)
+        yield
+
+
+class StoreMaker:
+    """Creates a new store (:func:`_create_store`) while the sweep's process runs its first batch.
+
+    Making a store imports xarray, Dask's arrays and Zarr and writes the
+    metadata: ~1.5 s of one core, as much as the first batch (which loads the
+    solver). On Linux a forked process makes it meanwhile (forked first,
+    before any thread of this process exists); elsewhere, and for a store in
+    memory, :meth:`result` makes it here. :meth:`result` gives what
+    :func:`_create_store` returns or raises what it raised; :meth:`close`
+    stops an unfinished maker (an interrupt), which removes its partial
+    directory as :func:`_create_store` does.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+    out : Path or None
+        The store's directory (None: in memory).
+    chunk : tuple of int
+    """
+
+    def __init__(self, spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> None:
+        import multiprocessing as mp
+        import sys
+
+        self._args = (spec, out, chunk)
+        self._proc: Any = None
+        self._conn: Any = None
+        if out is not None and sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods():
+            ctx = mp.get_context("fork")
+            self._conn, send = ctx.Pipe(duplex=False)
+            self._proc = ctx.Process(target=_make_in_child, args=(*self._args, send), daemon=True,
+                                     name="impactbeam-store")
+            self._proc.start()
+            send.close()
+
+    def result(self) -> Any:
+        """The store (its path, or the in-memory store), once made."""
+        if self._proc is None:
+            return _create_store(*self._args)
+        try:
+            kind, value = self._conn.recv()
+        except EOFError:
+            kind, value = "error", None
+        finally:
+            self._conn.close()
+            self._proc.join()
+            code, self._proc = self._proc.exitcode, None
+        if kind == "ok":
+            return value
+        if isinstance(value, BaseException):
+            raise value
+        from ..exceptions import ImpactBeamError
+
+        raise ImpactBeamError(f"--out: creating the store failed ({value or f'its process ended with status {code}'})")
+
+    def close(self) -> None:
+        """Stop a maker still running (it removes its partial directory) and wait for it."""
+        if self._proc is None:
+            return
+        import signal
+
+        if self._proc.is_alive():
+            with contextlib.suppress(OSError):
+                os.kill(self._proc.pid, signal.SIGTERM)
+        self._proc.join(10.0)
+        if self._proc.is_alive():
+            self._proc.kill()
+            self._proc.join()
+        self._conn.close()
+        self._proc = None
+
+
+def _make_in_child(spec: SweepSpec, out: Path, chunk: tuple[int, ...], conn: Any) -> None:
+    """The forked maker: send ("ok", path) or ("error", the exception, or its text if it does not pickle)."""
+    import pickle
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the sweep's process decides; SIGTERM (close) stops this one
+    signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        msg: tuple[str, Any] = ("ok", _create_store(spec, out, chunk))
+    except BaseException as exc:  # noqa: BLE001 - everything is reported to the sweep's process
+        try:
+            pickle.loads(pickle.dumps(exc))
+            msg = ("error", exc)
+        except Exception:
+            msg = ("error", f"{type(exc).__name__}: {exc}")
+    with contextlib.suppress(OSError):
+        conn.send(msg)
+    conn.close()
+
+
+def _raise_interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def open_result(spec: SweepSpec, store: Any, in_memory: bool) -> xr.Dataset:
+    """The sweep's results as a Dataset: variables in the sweep's order; loaded for an in-memory store."""
+    import xarray as xr
+
+    ds = xr.open_zarr(store, consolidated=False, chunks=None)
+    order = [*spec.metrics, *statistic_names(spec), "status", "message", *(["w"] if spec.histories is not None else [])]
+    ds = ds[order]  # the store lists its arrays in no particular order
+    return ds.load() if in_memory else ds
 
 
 def _open_existing(spec: SweepSpec, out: Path) -> Any:
