@@ -56,6 +56,12 @@ class SweepInterrupted(KeyboardInterrupt):
 class SweepRun:
     """Outcome of :func:`run_sweep`.
 
+    Parameters
+    ----------
+    opener : callable
+        Returns the results as a Dataset (called once, on first use of
+        :attr:`dataset`).
+
     Attributes
     ----------
     dataset : xarray.Dataset
