@@ -12,6 +12,13 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 # Figures render off-screen; the library itself never chooses a backend.
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+# Mode sets kept between processes (impactbeam.modal.disk_cache) go to a directory of this session, not
+# the user's cache: every test session starts from computed sets, and its command-line runs share them.
+if "IMPACTBEAM_CACHE_DIR" not in os.environ:
+    import tempfile
+
+    os.environ["IMPACTBEAM_CACHE_DIR"] = tempfile.mkdtemp(prefix="impactbeam-test-cache-")
+
 
 import pytest  # noqa: E402
 

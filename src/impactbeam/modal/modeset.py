@@ -70,6 +70,7 @@ from .euler import (
     rigid_modes,
 )
 from ..model.beam import Beam
+from .disk_cache import stored
 from ..exceptions import ParameterError
 
 if TYPE_CHECKING:
@@ -442,7 +443,8 @@ def _normalise(ms: ModeSet, groups: list[tuple[int, int]]) -> None:
 
 @functools.lru_cache(maxsize=512)
 def _cached(beam: Beam, springs: tuple[tuple[float, float], ...], count: int) -> ModeSet:
-    return _build(layout(beam, springs), beam, springs, count)
+    # in this process by the LRU cache, between processes by the files of .disk_cache (the same bits)
+    return stored(("mode_set", beam, springs, count), lambda: _build(layout(beam, springs), beam, springs, count))
 
 
 def mode_set(beam: Beam, springs: Iterable[tuple[float, float]] = (), count: int = 8) -> ModeSet:
