@@ -21,12 +21,12 @@ metrics and the Python around them comes from timing each compiled call.
 ``--first-use`` also measures fresh processes of ``impactbeam simulate
 examples/case03.toml`` (0.2 s, 26 segments) and of the harmonic example
 run for 10 s (examples/periodic/specimen_harmonic.toml, 1,200 segments), with
-an empty numba cache (a fresh ``NUMBA_CACHE_DIR``: a short run stays on the
-interpreted kernels, a long one starts the background compile and goes on
-interpreted), the compile of every kernel (``python -m
-impactbeam.solver.warmup``, what ``make install`` runs), and the same two
-processes with the compiled kernels cached: wall and CPU time (user + sys)
-of each process.
+an empty numba cache and no stored mode set (a fresh ``NUMBA_CACHE_DIR`` and
+``IMPACTBEAM_CACHE_DIR``: a short run stays on the interpreted kernels, a
+long one starts the background compile and goes on interpreted), the
+compile of every kernel (``python -m impactbeam.solver.warmup``, what
+``make install`` runs), and the same processes with the compiled kernels
+and the mode sets cached: wall and CPU time (user + sys) of each process.
 
 Run with ``python benchmarks/bench_solver.py [--repeats N] [--first-use]``.
 """
@@ -210,7 +210,7 @@ def first_use() -> None:
     print(f"\nfirst use ({os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}); wall and CPU (user + sys) "
           "of each process:")
     with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, IMPACTBEAM_CACHE_DIR=cache)  # no kernel, no mode set stored
 
         def one(label: str, cmd: list[str]) -> None:
             r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -234,7 +234,8 @@ def first_use() -> None:
         with tempfile.TemporaryDirectory() as other:
             env["NUMBA_CACHE_DIR"] = other
             one("python -m impactbeam.solver.warmup (every kernel, as make install)", warm)
-            one("simulate case03.toml, compiled kernels cached (not needed)", short)
+            one("simulate case03.toml, kernels and mode sets cached (a second process)", short)
+            one("the same again", short)
             one("simulate periodic/specimen_harmonic.toml --end-time 10, kernels cached", long)
             env["NUMBA_CACHE_DIR"] = cache
 
