@@ -236,6 +236,48 @@ def analyse_steady_state(
     -------
     SteadyState
     """
+    return _record_analysis(result, scenario, settle_periods, record_periods, tolerance, max_period, start,
+                            settled_after).steady_state()
+
+
+@dataclasses.dataclass(frozen=True)
+class _RecordAnalysis:
+    """The record of a run analysed but for its extremes (:func:`analyse_steady_state` adds them).
+
+    A run whose period is not found is extended (:func:`settle_and_record`):
+    its extremes are never used, and searching them (every segment of the
+    record) cost as much as a fifth of a bifurcation diagram.
+    """
+
+    result: SimulationResult
+    frequency: float
+    period: int
+    impacts_per_period: float
+    strobe_point: float
+    times: np.ndarray
+    window: tuple[float, float]
+    mismatch: float
+    settled_after: int
+    warnings: list[str]
+
+    def steady_state(self) -> SteadyState:
+        """The steady state, its extremes over the record searched now."""
+        sol = self.result.solution
+        x0, (lo, hi) = self.strobe_point, self.window
+        at = sol.sample(np.array([x0]), self.times)
+        ext = sol.extrema([(x0, lo, hi, 1.0, 0.0, None), (x0, lo, hi, -1.0, 0.0, None)])
+        return SteadyState(
+            frequency=self.frequency, period=self.period, impacts_per_period=self.impacts_per_period,
+            strobe=at.w[:-1, 0].copy(), strobe_velocity=at.w_t[:-1, 0].copy(), times=self.times[:-1].copy(),
+            max=float(ext[0, 0]), min=float(-ext[1, 0]), mismatch=self.mismatch, point=x0, window=self.window,
+            result=self.result, settled_after=self.settled_after, warnings=self.warnings,
+        )
+
+
+def _record_analysis(result: SimulationResult, scenario: Scenario, settle_periods: int, record_periods: int,
+                     tolerance: float, max_period: int | None, start: float | None,
+                     settled_after: int | None) -> _RecordAnalysis:
+    """Strobe samples and period of the record (the part of :func:`analyse_steady_state` that decides)."""
     T = harmonic_period(scenario)
     t_load = scenario.excitation.start if start is None else float(start)
     sol = result.solution
@@ -244,7 +286,6 @@ def analyse_steady_state(
     probes = _probe_points(scenario)
     smp = sol.sample(probes, times)
     x0 = strobe_point(scenario)
-    at = sol.sample(np.array([x0]), times)
     lo, hi = float(times[0]), float(times[-1])
     warns: list[str] = []
     if result.status != 0:
@@ -274,13 +315,7 @@ def analyse_steady_state(
             f"(smallest mismatch {mism:.3g}): {why} after {before} periods; "
             "impacts_per_period is the mean per forcing period"
         )
-    ext = sol.extrema([(x0, lo, hi, 1.0, 0.0, None), (x0, lo, hi, -1.0, 0.0, None)])
-    return SteadyState(
-        frequency=1.0 / T, period=n, impacts_per_period=float(ipp), strobe=at.w[:-1, 0].copy(),
-        strobe_velocity=at.w_t[:-1, 0].copy(), times=times[:-1].copy(), max=float(ext[0, 0]),
-        min=float(-ext[1, 0]), mismatch=float(mism), point=x0, window=(lo, hi), result=result,
-        settled_after=before, warnings=warns,
-    )
+    return _RecordAnalysis(result, 1.0 / T, n, float(ipp), x0, times, (lo, hi), float(mism), before, warns)
 
 
 def _event_arrays(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
@@ -370,9 +405,8 @@ def settle_and_record(scenario: Scenario, settle: int, record: int, start_state:
     res, t_load = run_periods(scenario, settle + record, start_state=start_state)
     done = settle
     while True:
-        ss = analyse_steady_state(res, scenario, settle_periods=settle, record_periods=record, tolerance=tolerance,
-                                  max_period=max_period, start=t_load, settled_after=done)
-        if ss.period or res.status != 0 or done + settle + record > limit:
-            return ss
+        rec = _record_analysis(res, scenario, settle, record, tolerance, max_period, t_load, done)
+        if rec.period or res.status != 0 or done + settle + record > limit:
+            return rec.steady_state()
         res, t_load = run_periods(scenario, settle + record, start_state=res.final_state())
         done += settle + record
