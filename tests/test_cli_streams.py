@@ -143,3 +143,32 @@ def test_the_convergence_estimate_reports_its_own_runs():
     est = seen[n_run:]
     assert len(est) >= 2 and est[-1] == 2.0 and all(b >= a for a, b in zip(est, est[1:]))
     assert res.estimate_convergence(seen.append) is conv and len(seen) == n_run + len(est)  # computed once
+
+
+# the script's quick exit (impactbeam.cli.console_main ends the process with os._exit)
+
+
+def test_console_exit_keeps_status_and_output(tmp_path):
+    """The script's quick exit: stdout complete through a pipe, exit status 0, 2 (bad input) kept."""
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    cli = [sys.executable, "-m", "impactbeam"]
+
+    def run(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([*cli, *args], capture_output=True, text=True, env=env, timeout=300)
+
+    ok = run("simulate", str(EXAMPLES / "case03.toml"), "--json", "--end-time", "0.02")
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["n_impacts"] >= 0  # the whole JSON arrived
+    bad = run("simulate", str(tmp_path / "missing.toml"))
+    assert bad.returncode == 2 and bad.stderr.startswith("error:")
+    version = run("--version")
+    assert version.returncode == 0 and "impactbeam" in version.stdout
+
+
+def test_large_output_through_a_pipe_is_complete(tmp_path):
+    """More than a pipe's buffer of output (a CSV written to stdout would be): flushed before the exit."""
+    code = ("import sys\nsys.argv = ['impactbeam', '--help']\nfrom impactbeam.cli import console_main\n"
+            "print('x' * 200000)\nconsole_main()\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0
+    assert out.stdout.startswith("x" * 200000) and "Usage" in out.stdout

@@ -1,18 +1,14 @@
-"""Making a sweep's store beside its first batch, the default batches, and the command line's quick exit.
+"""Making a sweep's store beside its first batch, and the default batches.
 
 A new store is made by a forked process while the sweep's own process runs
 its first batch (:class:`impactbeam.sweeps.store.StoreMaker`). These tests
 check what that must not change: the store's contents (compared with one
 made in the process), the errors (the maker's exception reaches the caller,
-its message intact), an interrupt (nothing half-written is left), and the
-exit status and output of the ``impactbeam`` script, which ends its process
-with ``os._exit`` once the command is done.
+its message intact) and an interrupt (nothing half-written is left).
 """
 
 from __future__ import annotations
 
-import os
-import subprocess
 import sys
 import time
 import tomllib
@@ -144,32 +140,3 @@ def test_default_batch_of_a_sweep_counts_its_histories():
     assert spec.default_batch() == default_batch_size(spec.n_cases, per_case)
     assert spec.default_batch() == default_batch_size(spec.n_cases)  # small here: bounded by the count
     assert _spec().default_batch() == default_batch_size(6)
-
-
-def _script() -> list[str]:
-    return [sys.executable, "-m", "impactbeam"]
-
-
-def test_console_exit_keeps_status_and_output(tmp_path):
-    """The script's quick exit: stdout complete through a pipe, exit status 0, 2 (bad input) kept."""
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    ok = subprocess.run([*_script(), "simulate", str(CASE3), "--json", "--end-time", "0.02"],
-                        capture_output=True, text=True, env=env, timeout=300)
-    assert ok.returncode == 0, ok.stderr
-    import json
-
-    assert json.loads(ok.stdout)["n_impacts"] >= 0  # the whole JSON arrived
-    bad = subprocess.run([*_script(), "simulate", str(tmp_path / "missing.toml")], capture_output=True, text=True,
-                         env=env, timeout=300)
-    assert bad.returncode == 2 and bad.stderr.startswith("error:")
-    version = subprocess.run([*_script(), "--version"], capture_output=True, text=True, env=env, timeout=300)
-    assert version.returncode == 0 and "impactbeam" in version.stdout
-
-
-def test_large_output_through_a_pipe_is_complete(tmp_path):
-    """More than a pipe's buffer of output (a CSV written to stdout would be): flushed before the exit."""
-    code = ("import sys\nsys.argv = ['impactbeam', '--help']\nfrom impactbeam.cli import console_main\n"
-            "print('x' * 200000)\nconsole_main()\n")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0
-    assert out.stdout.startswith("x" * 200000) and "Usage" in out.stdout
