@@ -51,7 +51,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from ..exceptions import ParameterError
 from ..modal import static_state
@@ -167,10 +166,15 @@ def _lcp(flex: np.ndarray, d0: np.ndarray, k: np.ndarray) -> np.ndarray:
     """
     if d0.size == 0:
         return np.zeros(0)
+    # imported here: SciPy's linear algebra and optimiser cost ~0.2 s and ~0.15 s to import, and few runs
+    # start from an equilibrium (a short run on the interpreted kernels, its mode sets stored, needs neither;
+    # numba's compiled target imports the linear algebra itself)
+    import scipy.linalg
+    from scipy.optimize import nnls
+
     M = 0.5 * (flex + flex.T) + np.diag(1.0 / k)
     R = scipy.linalg.cholesky(M, lower=False)
     rhs = scipy.linalg.solve_triangular(R, d0, trans="T")
-    from scipy.optimize import nnls  # here: importing it costs ~0.15 s, and few runs start from an equilibrium
 
     lam, _ = nnls(R, rhs, maxiter=50 * d0.size + 100)
     return lam
