@@ -154,3 +154,23 @@ def test_simulation_with_stored_sets_is_the_same_bits(cache):
     again = ib.simulate(sc).metrics()
     assert len(_files(cache)) == n  # every set read, none built
     assert again == first
+
+
+def test_no_home_directory_means_no_cache(monkeypatch):
+    """Without HOME (expanduser leaves "~"), nothing is written to a "~" directory in the working directory."""
+    monkeypatch.delenv("IMPACTBEAM_CACHE_DIR", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setattr(os.path, "expanduser", lambda p: p)
+    assert disk_cache.cache_dir() is None
+    monkeypatch.setenv("XDG_CACHE_HOME", "/somewhere")
+    assert disk_cache.cache_dir() == Path("/somewhere/impactbeam/modes")
+
+
+def test_unreadable_sources_store_nothing(cache, monkeypatch):
+    """A digest of no source (a zipped install) cannot tell versions apart: nothing is stored."""
+    monkeypatch.setattr(disk_cache, "_DIGEST", "")
+    beam = _beam()
+    ref = ib.mode_set(beam, (), 4)
+    assert _files(cache) == []
+    _cached.cache_clear()
+    _same_bits(ib.mode_set(beam, (), 4), ref)

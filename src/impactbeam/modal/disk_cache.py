@@ -13,9 +13,11 @@ A file stands for one set only when everything that made it is the same:
 * the arguments (the beam, the engaged springs, the count), pickled into
   the file's key and compared in full when it is read (a hash collision or
   a truncated file is a miss, never another set);
-* the code: the key includes a digest of every source file of the package
-  and the versions of NumPy and SciPy and the CPU features NumPy dispatches
-  on (its vector paths may round differently on another processor).
+* the code: the key includes a digest of every source file of the package,
+  its version, the versions of NumPy and SciPy and the CPU features NumPy
+  dispatches on (its vector paths may round differently on another
+  processor); where the sources cannot be read (a zipped install) nothing
+  is stored.
 
 A file that cannot be read is computed again and rewritten; a directory
 that cannot be written leaves every set computed as before. Writes are
@@ -25,7 +27,7 @@ workers) never read half a file. The directory holds at most
 
 Where: ``IMPACTBEAM_CACHE_DIR`` if set (an empty value or ``off`` turns
 the cache off), else ``$XDG_CACHE_HOME/impactbeam/modes`` or
-``~/.cache/impactbeam/modes``.
+``~/.cache/impactbeam/modes`` (none without a home directory).
 """
 
 from __future__ import annotations
@@ -56,17 +58,24 @@ def cache_dir() -> Path | None:
     if env is not None:
         return None if env.strip().lower() in ("", "off", "0", "none") else Path(env) / "modes"
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    if not os.path.isabs(base):  # no home directory (expanduser left "~"): no cache, not a "~" in the cwd
+        return None
     return Path(base) / "impactbeam" / "modes"
 
 
-def code_digest() -> str:
-    """SHA-256 of the package's sources, NumPy's and SciPy's versions and NumPy's dispatched CPU features."""
+def code_digest() -> str | None:
+    """SHA-256 of the package's sources, NumPy's and SciPy's versions and NumPy's dispatched CPU features.
+
+    None when the sources cannot be read (a zipped install): then nothing is stored.
+    """
     global _DIGEST
     if _DIGEST is None:
         import numpy as np
         import scipy
 
-        h = hashlib.sha256(f"numpy {np.__version__} scipy {scipy.__version__}".encode())
+        from .. import __version__
+
+        h = hashlib.sha256(f"impactbeam {__version__} numpy {np.__version__} scipy {scipy.__version__}".encode())
         try:
             from numpy._core._multiarray_umath import __cpu_features__ as features
         except ImportError:  # another NumPy layout: the version alone
@@ -77,11 +86,14 @@ def code_digest() -> str:
         for where, dirs, files in os.walk(root):
             dirs[:] = [d for d in dirs if d != "__pycache__"]  # numba's cache files live there too
             sources += [os.path.join(where, f) for f in files if f.endswith(".py")]
-        for path in sorted(sources):
-            h.update(os.path.relpath(path, root).encode())
-            h.update(Path(path).read_bytes())
-        _DIGEST = h.hexdigest()
-    return _DIGEST
+        try:
+            for path in sorted(sources):
+                h.update(os.path.relpath(path, root).encode())
+                h.update(Path(path).read_bytes())
+        except OSError:
+            sources = []
+        _DIGEST = h.hexdigest() if sources else ""
+    return _DIGEST or None
 
 
 def stored(key: tuple[Any, ...], compute: Callable[[], T]) -> T:
@@ -100,13 +112,14 @@ def stored(key: tuple[Any, ...], compute: Callable[[], T]) -> T:
         The value: read from the file, or computed (and written).
     """
     where = cache_dir()
-    if where is None:
+    digest = code_digest() if where is not None else None
+    if digest is None:
         return compute()
     try:
         blob = pickle.dumps(key, protocol=_PROTOCOL)
     except Exception:  # an argument that does not pickle: no file for it
         return compute()
-    name = hashlib.sha256(code_digest().encode() + blob).hexdigest()
+    name = hashlib.sha256(digest.encode() + blob).hexdigest()
     path = where / name[:2] / f"{name}.pkl"
     found = _read(path, blob)
     if found is not None:
