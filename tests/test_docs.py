@@ -150,3 +150,22 @@ def test_every_docs_page_is_in_a_table_of_contents() -> None:
     index = (DOCS / "index.md").read_text()
     pages = {p.stem for p in DOCS.glob("*.md")} - {"index"}
     assert not [p for p in pages if f"\n{p}\n" not in index], "add the page to a toctree of docs/index.md"
+
+
+def test_environment_defaults(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The defaults in docs/cli.md's "Environment" table are the code's."""
+    from impactbeam import _memory
+    from impactbeam.modal import disk_cache
+
+    text = (DOCS / "cli.md").read_text()
+    rows = {m.group(1): m.group(2) for m in re.finditer(r"^\| `(\w+)` \|[^|]*\| (.*) \|$", text, re.M)}
+    for var in ("IMPACTBEAM_MEMORY_LIMIT", "IMPACTBEAM_WORK_LIMIT", "IMPACTBEAM_CACHE_DIR", "XDG_CACHE_HOME"):
+        monkeypatch.delenv(var, raising=False)
+    assert rows["IMPACTBEAM_WORK_LIMIT"] == f"{_memory.work_limit():.0e}".replace("e+0", "e")
+    gib = _memory._size("IMPACTBEAM_MEMORY_LIMIT", 4 << 30) / 2**30
+    assert rows["IMPACTBEAM_MEMORY_LIMIT"].startswith(f"{gib:g} GiB")
+    home = Path(os.path.expanduser("~"))
+    assert disk_cache.cache_dir() == home / ".cache" / "impactbeam" / "modes"
+    assert "`~/.cache/impactbeam`" in rows["IMPACTBEAM_CACHE_DIR"]
+    monkeypatch.setenv("IMPACTBEAM_CACHE_DIR", "off")
+    assert disk_cache.cache_dir() is None
