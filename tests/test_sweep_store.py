@@ -133,10 +133,16 @@ def test_default_batches_are_few_and_bounded():
     assert default_batch_size(100, 1e9) == 1  # a case larger than the bound still runs, alone
 
 
-def test_default_batch_of_a_sweep_counts_its_histories():
+def test_default_batch_of_a_sweep_counts_its_histories(monkeypatch):
+    """A sweep's default batch is bounded by its histories' bytes (a bound made to bind on this small grid)."""
+    from impactbeam.sweeps import spec as spec_mod
+
     text = GRID + 'histories = { points = [0.05, 0.1], time_step = 1e-5 }\n'
     spec = _spec(text)
     per_case = 8.0 * spec.history_times().size * 2
-    assert spec.default_batch() == default_batch_size(spec.n_cases, per_case)
-    assert spec.default_batch() == default_batch_size(spec.n_cases)  # small here: bounded by the count
-    assert _spec().default_batch() == default_batch_size(6)
+    assert spec.history_bytes() == per_case and _spec().history_bytes() == 0.0
+    monkeypatch.setattr(spec_mod, "_DEFAULT_BATCHES", 1)  # by count alone: one batch of all 6 cases
+    monkeypatch.setattr(spec_mod, "_DEFAULT_BATCH_BYTES", 2.5 * per_case)
+    assert default_batch_size(spec.n_cases) == 6
+    assert spec.default_batch() == 2  # two cases' histories fit the bound
+    assert _spec().default_batch() == 6  # without histories only the count bounds it

@@ -36,7 +36,6 @@ import contextlib
 import hashlib
 import os
 import pickle
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -143,26 +142,20 @@ def _read(path: Path, blob: bytes) -> tuple[Any] | None:
 
 
 def _write(where: Path, path: Path, blob: bytes, value: Any) -> None:
+    from .._io import write_bytes
+
     try:
         data = pickle.dumps((blob, value), protocol=_PROTOCOL)
     except Exception:
         return
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".pkl")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
-            os.replace(tmp, path)
-        except BaseException:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-            raise
+        write_bytes(path, data)  # atomic: a concurrent reader (a sweep's worker) never sees half a file
         global _WRITES
         if _WRITES % 100 == 0:
             _prune(where)
         _WRITES += 1
-    except OSError:  # read-only, full or missing: the value is used without being kept
+    except OSError:  # read-only, full or missing (WriteError is one): the value is used without being kept
         return
 
 

@@ -15,7 +15,7 @@ from typing import Any
 from .._optional import require
 from ..exceptions import ParameterError
 
-__all__ = ["WORKER_BYTES", "check_workers", "dask_client", "worker_config"]
+__all__ = ["WORKER_BYTES", "check_workers", "dask_client", "fork_context", "worker_config"]
 
 #: Memory of one worker of the local cluster once it has run a case: its process (~190 MiB
 #: resident after one Case-3 simulation, measured) and its nanny (~60 MiB).
@@ -123,3 +123,19 @@ def dask_client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
         finally:
             if cluster is not None:
                 cluster.close()
+
+
+def fork_context() -> Any:
+    """The multiprocessing context that forks this process where forking is safe to use (Linux), else None.
+
+    A forked process starts at once with what this one has loaded (the
+    solver's kernels, the problem's states); elsewhere (macOS, Windows)
+    processes are spawned, or the work is done in this process.
+    """
+    import multiprocessing as mp
+    import sys
+
+    if sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods():
+        return mp.get_context("fork")
+    return None
+

@@ -5,7 +5,6 @@ from __future__ import annotations
 import logging
 import os
 import signal
-import sys
 import threading
 from functools import partial
 from collections.abc import Iterator, Mapping
@@ -20,7 +19,7 @@ from .._warnings import Progress
 from ..exceptions import ImpactBeamError, ParameterError, SimulationError
 if TYPE_CHECKING:
     import xarray as xr
-from .cluster import check_workers, dask_client
+from .cluster import check_workers, dask_client, fork_context
 from .batches import (
     _Batch,
     _chunk_shape,
@@ -244,9 +243,7 @@ def _check_in_memory(spec: SweepSpec) -> None:
     """Refuse, before any work, an in-memory result larger than the memory limit."""
     from .._memory import check_memory
 
-    per_case = 8 * len(spec.metrics) + 40
-    if spec.histories is not None:
-        per_case += 8 * spec.history_times().size * len(spec.histories.points)
+    per_case = 8 * len(spec.metrics) + 40 + spec.history_bytes()
     check_memory(per_case * spec.n_cases, f"an in-memory sweep of {spec.n_cases} cases",
                  "write it to a store (out=...), or sweep fewer cases or histories")
 
@@ -375,8 +372,7 @@ class _LocalWorkers:
             except Exception as exc:
                 self.finished.put((first.region, None, exc))
             self.in_flight += 1
-        fork = sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods()
-        ctx = mp.get_context("fork" if fork else "spawn")
+        ctx = fork_context() or mp.get_context("spawn")
         self.pool = ctx.Pool(self.workers, initializer=_worker_start)
         while self.in_flight < self.window and self._submit():
             pass

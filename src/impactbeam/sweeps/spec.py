@@ -289,12 +289,15 @@ class SweepSpec:
         """SHA-256 of :meth:`canonical`: equal for sweeps that compute the same cases."""
         return hashlib.sha256(self.canonical_json.encode()).hexdigest()
 
+    def history_bytes(self) -> float:
+        """Bytes of one case's histories (``w`` at every history time and point; 0 without histories)."""
+        if self.histories is None:
+            return 0.0
+        return 8.0 * self.history_times().size * len(self.histories.points)
+
     def default_batch(self) -> int:
         """:func:`default_batch_size` of this sweep (its cases, the bytes of one case's histories)."""
-        per_case = 0.0
-        if self.histories is not None:
-            per_case = 8.0 * self.history_times().size * len(self.histories.points)
-        return default_batch_size(self.n_cases, per_case)
+        return default_batch_size(self.n_cases, self.history_bytes())
 
     def history_times(self) -> np.ndarray:
         """The coarse time grid of the histories: 0, dt, ... up to the longest end_time."""
@@ -338,8 +341,7 @@ class SweepSpec:
                          f"{'s' if d != 1 else ''}", "draw fewer samples")
         if self.histories is not None:
             batch = batch_cases or self.default_batch()
-            per_case = 8.0 * self.history_times().size * len(self.histories.points)
-            check_memory(3.0 * batch * per_case, f"outputs.histories: a batch of {batch} cases of "
+            check_memory(3.0 * batch * self.history_bytes(), f"outputs.histories: a batch of {batch} cases of "
                          f"{self.history_times().size} samples at {len(self.histories.points)} points",
                          "use a larger outputs.histories.time_step, fewer points or a smaller --batch-size")
 

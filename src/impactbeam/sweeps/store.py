@@ -199,14 +199,13 @@ class StoreMaker:
     """
 
     def __init__(self, spec: SweepSpec, out: Path | None, chunk: tuple[int, ...]) -> None:
-        import multiprocessing as mp
-        import sys
+        from .cluster import fork_context
 
         self._args = (spec, out, chunk)
         self._proc: Any = None
         self._conn: Any = None
-        if out is not None and sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods():
-            ctx = mp.get_context("fork")
+        ctx = fork_context() if out is not None else None
+        if ctx is not None:
             self._conn, send = ctx.Pipe(duplex=False)
             self._proc = ctx.Process(target=_make_in_child, args=(*self._args, send), daemon=True,
                                      name="impactbeam-store")
