@@ -342,3 +342,25 @@ def test_a_batch_solution_handed_to_case_done_survives_the_next_cases(monkeypatc
     assert kept[0].t0.size > 64
     for u, v in zip(_records(alone), _records(kept[0])):
         np.testing.assert_array_equal(u, v)
+
+
+def test_a_system_is_checked_once_and_a_refusal_every_time(monkeypatch):
+    # simulate checks what the model cannot represent (_check_system) and remembers a system that passed:
+    # the second run of one scenario does not check again, gives the same bits, and a new excitation object
+    # (held by a weak reference only) is checked afresh; a refused system is refused on every call.
+    from impactbeam import simulation
+
+    calls = []
+    real = simulation._check_system
+    monkeypatch.setattr(simulation, "_check_system", lambda *a: calls.append(a) or real(*a))
+    monkeypatch.setattr(simulation, "_CHECKED", type(simulation._CHECKED)())
+    sc = _case3().with_values({"solver.end_time": 0.05})
+    first = ib.simulate(sc).metrics()
+    second = ib.simulate(sc).metrics()
+    assert len(calls) == 1 and first == second
+    ib.simulate(dataclasses.replace(sc, excitation=dataclasses.replace(sc.excitation)))
+    assert len(calls) == 2
+    for expected in (3, 4):  # an output point off the 0.1092 m beam
+        with pytest.raises(ib.ParameterError, match="output.points"):
+            ib.simulate_system(sc.beam, sc.contactors, excitation=sc.excitation, options=sc.solver, points=[1.0])
+        assert len(calls) == expected

@@ -13,6 +13,8 @@ from __future__ import annotations
 import dataclasses
 import functools
 import os
+import weakref
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
@@ -86,7 +88,7 @@ def simulate_system(
     initial = initial or InitialCondition()
     options = options or SolverOptions()
     contactors = tuple(contactors)
-    pts_arr = _check_system(beam, contactors, excitation, initial, options, points, method)
+    pts_arr = _checked_points(beam, contactors, excitation, initial, options, points, method)
     _check_start(start, beam, contactors, options, method, excitation)
 
     def run(n_modes: int, *, announce: bool = True,
@@ -111,6 +113,35 @@ def simulate_system(
     if options.modes != "auto":
         return run(int(options.modes))
     return _auto_modes(run, options.tolerance)
+
+
+_CHECKED: OrderedDict[tuple, tuple[weakref.ref, np.ndarray]] = OrderedDict()  # systems that passed _check_system
+_CHECKED_SIZE = 64
+
+
+def _checked_points(beam: Beam, contactors: tuple[Contactor, ...], excitation: Excitation,
+                    initial: InitialCondition, options: SolverOptions, points: Sequence[float] | None,
+                    method: str) -> np.ndarray:
+    """:func:`_check_system`, remembered for systems that passed it.
+
+    The checks read only immutable inputs and either raise or return the
+    points, so a study repeating a system (the counts of a convergence
+    estimate, a benchmark) checks it once; a refusal is never remembered.
+    The excitation is held by a weak reference (a synthesised random load
+    can be large), so the memory stays that of the small inputs.
+    """
+    pts = None if points is None else tuple(np.asarray(points, dtype=float).ravel().tolist())
+    key = (beam, contactors, id(excitation), initial, options.end_time, options.modes, pts, method)
+    try:
+        hit = _CHECKED.get(key)
+    except TypeError:  # an unhashable field: check every time
+        return _check_system(beam, contactors, excitation, initial, options, points, method)
+    if hit is None or hit[0]() is not excitation:
+        hit = (weakref.ref(excitation), _check_system(beam, contactors, excitation, initial, options, points, method))
+        _CHECKED[key] = hit
+        if len(_CHECKED) > _CHECKED_SIZE:
+            _CHECKED.popitem(last=False)
+    return hit[1].copy()
 
 
 def _check_system(beam: Beam, contactors: tuple[Contactor, ...], excitation: Excitation, initial: InitialCondition,
@@ -446,7 +477,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
     points: dict[int, np.ndarray] = {}
     for k, c in enumerate(cases):
         try:
-            points[k] = _check_system(c.beam, c.contactors, c.excitation, c.initial, c.options, c.points, "exact")
+            points[k] = _checked_points(c.beam, c.contactors, c.excitation, c.initial, c.options, c.points, "exact")
             if c.options.modes == "auto":
                 raise _CaseByCase
             key = (pack_key(c.beam, c.contactors, c.damping, c.excitation, c.options, c.preload), c.initial.key(),

@@ -316,15 +316,17 @@ def _forces(result: ResultLike, intervals: Sequence[tuple[int, float, float]], p
     dashpot), ``ints`` the integrals of ``w`` at the contactor, ``d0, d1`` the
     compressions at the ends (read only with a dashpot).
     """
-    dash = getattr(result.solution, "dashpots", np.zeros(len(result.contactors)))
-    force, impulse = np.zeros(len(intervals)), np.zeros(len(intervals))
-    for i, ((ci, a, b), peak, iw, e0, e1) in enumerate(zip(intervals, peaks, ints, d0, d1)):
-        c = result.contactors[ci]
-        force[i] = c.stiffness * max(peak, 0.0)
-        impulse[i] = c.stiffness * (c.direction * iw - c.gap * (b - a))
+    con = result.contactors
+    dash = np.asarray(getattr(result.solution, "dashpots", np.zeros(len(con))), dtype=float).tolist()
+    k, s, gap = [c.stiffness for c in con], [c.direction for c in con], [c.gap for c in con]
+    force, impulse = [], []
+    for (ci, a, b), peak, iw, e0, e1 in zip(intervals, peaks, ints, d0, d1):
+        force.append(k[ci] * max(peak, 0.0))
+        imp = k[ci] * (s[ci] * iw - gap[ci] * (b - a))
         if dash[ci] > 0.0:
-            impulse[i] += dash[ci] * (e1 - e0)
-    return force, impulse
+            imp += dash[ci] * (e1 - e0)
+        impulse.append(imp)
+    return np.array(force, dtype=float), np.array(impulse, dtype=float)
 
 
 def _impact_table(result: ResultLike, rows: tuple) -> list[dict[str, Any]]:
