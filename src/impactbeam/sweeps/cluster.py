@@ -138,4 +138,3 @@ def fork_context() -> Any:
     if sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods():
         return mp.get_context("fork")
     return None
-
