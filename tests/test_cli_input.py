@@ -129,6 +129,22 @@ def test_modes_bad_count() -> None:
     assert_one_error_line(proc, 2, "--count")
 
 
+@pytest.mark.parametrize(
+    ("args", "needles"),
+    [(["simulate", "CASE3", "--bogus"], ["impactbeam simulate", "--bogus"]),
+     (["random", "CASE3", "--seeds", "x"], ["impactbeam random", "--seeds", "'x'"]),
+     (["bogus"], ["No such command", "'bogus'"]),
+     (["simulate"], ["impactbeam simulate", "SCENARIO"]),
+     (["--bogus"], ["--bogus"])],
+    ids=["unknown-option", "option-type", "unknown-command", "missing-argument", "group-option"],
+)
+def test_usage_errors_are_one_line(args: list[str], needles: list[str]) -> None:
+    # Reason: a mistyped option or command is bad input like a bad scenario value: status 2 and one
+    # line naming the option (click's own display takes three: usage, hint, error).
+    proc = run(*[str(EXAMPLES / "case03.toml") if a == "CASE3" else a for a in args])
+    assert_one_error_line(proc, 2, *needles)
+
+
 def test_help_and_info() -> None:
     # Reason: the entry point is installed and the cheap commands work without a scenario.
     proc = run("--help")

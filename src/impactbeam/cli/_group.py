@@ -232,8 +232,33 @@ def _handled() -> None:
     _received.clear()
 
 
+_NO_ARGS = getattr(click.exceptions, "NoArgsIsHelpError", ())  # click >= 8.2: the help for a bare group
+
+
+def _usage_error(exc: click.ClickException) -> None:
+    """A command-line usage error (unknown option or command, a value of the wrong type, a missing argument).
+
+    One ``error:`` line naming the command and the problem, exit status 2, as
+    for every bad input (click's own display takes three lines).
+    """
+    ctx = getattr(exc, "ctx", None)
+    where = f"{ctx.command_path}: " if ctx is not None else ""
+    hint = f" (see {ctx.command_path} --help)" if ctx is not None else ""
+    fail(f"{where}{exc.format_message().rstrip('.')}{hint}", exc.exit_code)
+
+
 class _Commands(click.Group):
-    """The command group: Ctrl-C exits 130 and SIGTERM 143, with one line, never a traceback."""
+    """The command group: Ctrl-C exits 130 and SIGTERM 143, with one line, never a traceback; a usage error one line."""
+
+    def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
+                     **extra: Any) -> click.Context:
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except _NO_ARGS:  # no command at all: the help, as click shows it
+            raise
+        except click.UsageError as exc:  # the group's own options
+            _usage_error(exc)
+            raise  # not reached: _usage_error exits
 
     def main(self, *args: Any, **kwargs: Any) -> Any:
         previous = _install_handlers()
@@ -249,6 +274,10 @@ class _Commands(click.Group):
     def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
+        except _NO_ARGS:
+            raise
+        except click.UsageError as exc:  # a command's options and arguments, or an unknown command
+            _usage_error(exc)
         except KeyboardInterrupt as exc:
             signum = int(getattr(exc, "signum", _received[0] if _received else signal.SIGINT))
             _handled()
