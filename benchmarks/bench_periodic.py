@@ -13,7 +13,10 @@ are timed in this process, one after the other; the script prints times,
 the ratio per point, the sweep time extrapolated for the baseline, and the
 largest strobe difference. It prints ratios, not pass/fail.
 
-Run with ``python benchmarks/bench_periodic.py [--points N] [--baseline-points M]``.
+Run with ``python benchmarks/bench_periodic.py [--points N] [--baseline-points M] [--breakdown]``;
+``--breakdown`` also says where the sweep's time goes: the compiled kernels
+(event loop, extremes of the records, strobe sampling) timed at each call, the
+rest being Python, and the forcing periods run against those asked.
 """
 
 from __future__ import annotations
@@ -44,10 +47,53 @@ def scenario() -> ib.Scenario:
     })
 
 
+class KernelClock:
+    """Wall time spent inside the compiled kernels' entry points while it is active (``with`` block)."""
+
+    NAMES = {"run": "event loop", "extremum": "extremes of the records", "sample": "strobe sampling"}
+
+    def __init__(self) -> None:
+        from impactbeam.solver import kernels
+
+        self.ns = kernels.compiled()
+        self.spent = dict.fromkeys(self.NAMES, 0.0)
+        self.calls = dict.fromkeys(self.NAMES, 0)
+
+    def __enter__(self) -> "KernelClock":
+        self.saved = {name: getattr(self.ns, name) for name in self.NAMES}
+        for name, fn in self.saved.items():
+            setattr(self.ns, name, self._timed(name, fn))
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for name, fn in self.saved.items():
+            setattr(self.ns, name, fn)
+
+    def _timed(self, name: str, fn):
+        def call(*args):
+            t0 = time.perf_counter()
+            try:
+                return fn(*args)
+            finally:
+                self.spent[name] += time.perf_counter() - t0
+                self.calls[name] += 1
+        return call
+
+    def report(self, total: float, periods: int, asked: int) -> None:
+        compiled = sum(self.spent.values())
+        for name, label in self.NAMES.items():
+            print(f"  {label:26s} {self.spent[name]:6.2f} s ({self.calls[name]} calls)")
+        print(f"  {'compiled, in all':26s} {compiled:6.2f} s ({compiled / total:.0%}); Python and the rest "
+              f"{total - compiled:.2f} s")
+        print(f"  forcing periods run {periods:,} ({asked:,} asked: the rest extend records whose period "
+              "was not found)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=400, help="forcing frequencies (each swept up and down)")
     ap.add_argument("--baseline-points", type=int, default=3, help="points run by the solve_ivp baseline")
+    ap.add_argument("--breakdown", action="store_true", help="time the compiled kernels inside the sweep too")
     args = ap.parse_args()
     warnings.simplefilter("ignore", ib.ImpactBeamWarning)  # counted below instead
     sc = scenario()
@@ -67,6 +113,16 @@ def main() -> None:
     print(f"exact engine: {args.points} frequencies up and down = {n_runs} steady states in {t_sweep:.2f} s "
           f"(target 1 s), {c_sweep:.2f} s CPU ({t_sweep / n_runs * 1e3:.2f} ms per point; {extended} extended while "
           f"settling, {no_period} without a period); {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
+    if args.breakdown:  # a second sweep, its kernels timed (the timing wrappers cost microseconds per call)
+        with KernelClock() as clock:
+            t0 = time.perf_counter()
+            again = ib.frequency_response(sc, freqs, sweep="both", settle_periods=SETTLE, record_periods=RECORD)
+            t_again = time.perf_counter() - t0
+        same = all(np.array_equal(a.state.strobe, b.state.strobe) and a.state.max == b.state.max
+                   for a, b in zip(fr.diagram.points, again.diagram.points))
+        print(f"where the time goes (a second sweep, {t_again:.2f} s; the same diagram to the bit: {same}):")
+        clock.report(t_again, sum(p.state.settled_after + RECORD for p in again.diagram.points),
+                     len(again.diagram.points) * (SETTLE + RECORD))
 
     picks = freqs[np.linspace(0, freqs.size - 1, args.baseline_points + 2).astype(int)[1:-1]]
     t_ivp = t_exact = 0.0
