@@ -145,6 +145,13 @@ def test_usage_errors_are_one_line(args: list[str], needles: list[str]) -> None:
     assert_one_error_line(proc, 2, *needles)
 
 
+def test_a_bare_command_shows_the_help() -> None:
+    # Reason: no command at all is not an error line: the help, as click shows it (on stderr with click >= 8.2).
+    proc = run()
+    assert "Usage: impactbeam" in proc.stdout + proc.stderr and "error:" not in proc.stderr
+    assert "simulate" in proc.stdout + proc.stderr
+
+
 def test_help_and_info() -> None:
     # Reason: the entry point is installed and the cheap commands work without a scenario.
     proc = run("--help")

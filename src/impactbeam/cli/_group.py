@@ -26,7 +26,7 @@ import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator, Mapping
-from typing import Any, TypeVar
+from typing import Any, NoReturn, TypeVar
 
 import click
 
@@ -37,7 +37,7 @@ __all__ = ["main", "console_main", "handle_errors", "take_warnings", "warning_li
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-def fail(message: str, status: int) -> None:
+def fail(message: str, status: int) -> NoReturn:
     """Print one ``error:`` line on stderr and exit with ``status``."""
     one_line = " ".join(str(message).split())
     click.echo(f"error: {one_line}", err=True)
@@ -235,12 +235,15 @@ def _handled() -> None:
 _NO_ARGS = getattr(click.exceptions, "NoArgsIsHelpError", ())  # click >= 8.2: the help for a bare group
 
 
-def _usage_error(exc: click.ClickException) -> None:
+def _usage_error(exc: click.UsageError) -> NoReturn:
     """A command-line usage error (unknown option or command, a value of the wrong type, a missing argument).
 
     One ``error:`` line naming the command and the problem, exit status 2, as
-    for every bad input (click's own display takes three lines).
+    for every bad input (click's own display takes three lines). A bare group
+    (no command at all) shows its help, as click does.
     """
+    if isinstance(exc, _NO_ARGS):
+        raise exc
     ctx = getattr(exc, "ctx", None)
     where = f"{ctx.command_path}: " if ctx is not None else ""
     hint = f" (see {ctx.command_path} --help)" if ctx is not None else ""
@@ -254,11 +257,8 @@ class _Commands(click.Group):
                      **extra: Any) -> click.Context:
         try:
             return super().make_context(info_name, args, parent=parent, **extra)
-        except _NO_ARGS:  # no command at all: the help, as click shows it
-            raise
         except click.UsageError as exc:  # the group's own options
             _usage_error(exc)
-            raise  # not reached: _usage_error exits
 
     def main(self, *args: Any, **kwargs: Any) -> Any:
         previous = _install_handlers()
@@ -274,8 +274,6 @@ class _Commands(click.Group):
     def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
-        except _NO_ARGS:
-            raise
         except click.UsageError as exc:  # a command's options and arguments, or an unknown command
             _usage_error(exc)
         except KeyboardInterrupt as exc:
