@@ -173,3 +173,23 @@ def test_commands_that_do_not_report_warnings_print_them_on_stderr() -> None:
     assert res.stderr == "warning: solver.modes: a word\n"
     res = CliRunner().invoke(cmd, ["--take"])
     assert res.stdout == "took ['solver.modes: a word']\ndone\n" and res.stderr == ""
+
+
+def test_one_mode_says_it_has_no_convergence_estimate(tmp_path: Path) -> None:
+    # a 1-mode run has no coarser run to compare with: its estimate is None, and that is said, not silent
+    p = tmp_path / "one.toml"
+    p.write_text(BEAM + CONTACTOR + PULSE + SHORT.replace("modes = 4", "modes = 1"))
+    res = ib.simulate(ib.load_scenario(p))
+    with pytest.warns(ib.ImpactBeamWarning, match="no convergence estimate with 1 mode per state") as rec:
+        assert res.convergence is None
+    assert len(rec) == 1 and rec[0].filename == __file__
+    assert not res.converged and res.impact_convergence is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ib.ImpactBeamWarning)
+        assert res.convergence is None  # said once, not at every access
+    assert any("no convergence estimate" in w for w in res.warnings)
+    out = json.loads(run("simulate", p, "--json").stdout)
+    assert out["convergence"] is None and out["modes"] == 1
+    assert [w for w in out["warnings"] if "no convergence estimate" in w]
+    two = ib.simulate(ib.load_scenario(p).with_values({"solver.modes": 2}))
+    assert two.convergence is not None  # compared with 1 mode
