@@ -115,16 +115,13 @@ class SimulationResult:
     @property
     def warnings(self) -> tuple[str, ...]:
         """The solver's warnings, and the convergence warning once :attr:`convergence` is known."""
+        from ..solver.convergence import NO_ESTIMATE, worst
+
         out = tuple(self.solution.warnings)
         conv = self.__dict__.get("_convergence")
         if conv is None and "_convergence" in self.__dict__:
-            out += (
-                f"no convergence estimate with {self.n_modes} mode per state (no coarser run to compare with): "
-                'the truncation error of the metrics is unknown; use more modes or solver.modes = "auto"',
-            )
+            out += (NO_ESTIMATE,)
         if conv is not None and not self.converged:
-            from ..solver.convergence import worst
-
             key, change = worst(conv)
             out += (
                 f"not converged in the number of modes: with {self.n_modes} modes the estimated error of {key} is "
@@ -162,11 +159,10 @@ class SimulationResult:
             from .._warnings import emit_user_level_warning as warn
             from ..solver.convergence import estimate_by_reruns
 
-            if self.rerun is None:
-                return None
-            if self.n_modes <= 1:  # nothing coarser to compare with: said, not silent
-                self.__dict__["_convergence"] = None
-                warn(self.warnings[-1])
+            if self.rerun is None or self.n_modes <= 1:
+                if self.rerun is not None:  # one mode: nothing coarser to compare with, said, not silent
+                    self.__dict__["_convergence"] = None
+                    warn(self.warnings[-1])
                 return None
             self.set_convergence(*estimate_by_reruns(self.metrics(), self.rerun, self.n_modes, self.end_time,
                                                      progress))
@@ -183,8 +179,7 @@ class SimulationResult:
         :attr:`convergence_counts`), computed on first access (with
         ``solver.modes = "auto"``, during the search); what it guarantees and
         where it does not: :mod:`impactbeam.solver.convergence`.
-        None when it cannot be computed: one mode (then :attr:`warnings` says
-        so), or a result without a re-run.
+        None when it cannot be computed (one mode, said in :attr:`warnings`; a result without a re-run).
         """
         return self.estimate_convergence()
 

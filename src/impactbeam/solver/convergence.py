@@ -54,9 +54,8 @@ from typing import Any
 import numpy as np
 
 __all__ = [
-    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "ConvergenceStudy", "coarser_counts", "estimate", "estimate_by_reruns",
-    "impact_changes", "relative_changes",
-    "worst",
+    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "NO_ESTIMATE", "ConvergenceStudy", "coarser_counts", "estimate",
+    "estimate_by_reruns", "impact_changes", "relative_changes", "worst",
 ]
 
 #: The counts an estimate compares with: for ``N``, the two largest up to ``3 N / 4``.
@@ -68,6 +67,9 @@ CONVERGENCE_METRICS = (
     "max_response", "t_max", "first_impact_time", "free_duration", "contact_duration", "min_response",
     "max_penetration", "n_impacts",
 )
+#: The warning of a run with one mode per state, which has no coarser run to compare with.
+NO_ESTIMATE = ("no convergence estimate with 1 mode per state (no coarser run to compare with): the truncation "
+               'error of the metrics is unknown; use more modes or solver.modes = "auto"')
 _DISPLACEMENTS = ("max_response", "min_response", "max_penetration")
 _TIME_FLOOR = 1e-9  # s
 _DISPLACEMENT_FLOOR = 1e-6  # of the largest displacement metric
