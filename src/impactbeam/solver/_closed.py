@@ -123,8 +123,7 @@ def particular(p, tau, Om, phi):  # pragma: no cover - compiled
     der = p[1] + tau * (2.0 * p[2] + 3.0 * p[3] * tau)
     if Om != 0.0:
         th = Om * tau + phi
-        s = math.sin(th)
-        c = math.cos(th)
+        s, c = sincos(th)
         val += p[4] * s + p[5] * c + tau * (p[6] * c + p[7] * s)
         der += Om * (p[4] * c - p[5] * s) + p[6] * (c - Om * tau * s) + p[7] * (s + Om * tau * c)
     return val, der
@@ -392,8 +391,7 @@ def derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, 
     against which a derivative counts as zero up to round-off). ``work``: a
     scratch array of shape ``(2, kmax + 2)``.
     """
-    sphi = math.sin(phi)
-    cphi = math.cos(phi)
+    sphi, cphi = sincos(phi)
     for k in range(kmax + 1):
         out[k] = 0.0
         mag[k] = 0.0
@@ -428,10 +426,8 @@ def _integral_particular(p, Om, phi, T):  # pragma: no cover - compiled
     ip = T * (p[0] + T * (p[1] / 2.0 + T * (p[2] / 3.0 + T * p[3] / 4.0)))
     if Om != 0.0:
         th1 = Om * T + phi
-        s0 = math.sin(phi)
-        c0 = math.cos(phi)
-        s1 = math.sin(th1)
-        c1 = math.cos(th1)
+        s0, c0 = sincos(phi)
+        s1, c1 = sincos(th1)
         ip += p[4] * (c0 - c1) / Om + p[5] * (s1 - s0) / Om
         if p[6] != 0.0:  # int tau cos(theta) = [tau sin/Om + cos/Om^2]
             ip += p[6] * (T * s1 / Om + (c1 - c0) / (Om * Om))

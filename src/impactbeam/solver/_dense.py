@@ -30,7 +30,7 @@ from ._jit import njit
 
 from ._closed import (
     NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup,
-    state_at, workspace,
+    sincos, state_at, workspace,
 )
 from ._events import SLOPE, brent
 from ._loop import load_value, to_modal
@@ -236,8 +236,7 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - 
     ddu = 2.0 * p[2] + 6.0 * p[3] * tau
     if Om != 0.0:
         th = Om * tau + phi
-        sn = math.sin(th)
-        cs = math.cos(th)
+        sn, cs = sincos(th)
         ddu += -Om * Om * (p[4] * sn + p[5] * cs) + p[6] * (-2.0 * Om * sn - Om * Om * tau * cs)
         ddu += p[7] * (2.0 * Om * cs - Om * Om * tau * sn)
     u += base[0]
