@@ -440,12 +440,26 @@ def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg
     return best, tbest
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@njit(cache=True, nogil=True)
 def extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val, out_t,
              seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
              kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
-    """:func:`extremum_query` for each query ``q``, on the rows ``Wr[row[q]]``: values and times into ``out_*``."""
-    work = dense_work(seg_eta.shape[1])
+    """:func:`extremum_query` for each query ``q``, on the rows ``Wr[row[q]]``: values and times into ``out_*``.
+
+    It makes the work arrays (so it counts references: a kernel without
+    reference counting never frees the arrays it makes) and hands them to
+    :func:`_extremum`.
+    """
+    _extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val, out_t, seg_t0, seg_t1, seg_s,
+              seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope,
+              pamp, pOm, pphase, dense_work(seg_eta.shape[1]))
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _extremum(lo, hi, sign, offset, rate, row, cond_bit, atol, xtol, Wr, out_val, out_t,
+              seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side,
+              kst, pt0, pconst, pslope, pamp, pOm, pphase, work):  # pragma: no cover - compiled
+    """The loop of :func:`extremum` on the work arrays it made."""
     for q in range(lo.size):
         out_val[q], out_t[q] = extremum_query(
             lo[q], hi[q], sign[q], offset[q], rate[q], Wr[row[q]], cond_bit[q], atol, xtol, seg_t0, seg_t1, seg_s,
@@ -482,11 +496,19 @@ def integral_query(lo, hi, Wq, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, 
     return total
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@njit(cache=True, nogil=True)
 def integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen,
              G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase):  # pragma: no cover - compiled
-    """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form."""
-    work = dense_work(seg_eta.shape[1])
+    """``out[q] = int_lo[q]^hi[q] Wr[row[q], s] . eta dt`` over the segments, in closed form (work arrays made
+    here, as in :func:`extremum`)."""
+    _integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen,
+              G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, dense_work(seg_eta.shape[1]))
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _integral(lo, hi, row, Wr, out, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW, gen,
+              G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, work):  # pragma: no cover - compiled
+    """The loop of :func:`integral` on the work arrays it made."""
     for q in range(lo.size):
         out[q] = integral_query(lo[q], hi[q], Wr[row[q]], seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec,
                                 wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm,
