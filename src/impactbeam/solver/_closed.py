@@ -76,9 +76,9 @@ def sincos(x):  # pragma: no cover - compiled
     """``(sin x, cos x)`` to within two units in the last place of the C library's values.
 
     Plain IEEE arithmetic (a polynomial after a three-part reduction by
-    pi/4), no library call: in the closed form's loops over the modes about
-    three times faster than the C library's ``sincos``, which took a third of
-    the event loop's time. Beyond ``|x| = 2**28`` it defers to the library.
+    pi/4), no library call: cheaper in the event loop's scans than the C
+    library's ``sincos``, which took about a third of that loop's time
+    (docs/performance.md). Beyond ``|x| = 2**28`` it defers to the library.
     """
     ax = abs(x)
     if not ax <= _REDUCED_MAX:
