@@ -35,6 +35,8 @@ import numpy as np  # noqa: E402
 import impactbeam as ib  # noqa: E402
 from impactbeam.periodic.strobe import analyse_steady_state, run_periods  # noqa: E402
 
+from _kernel_clock import KernelClock  # noqa: E402
+
 SPECIMEN = Path(__file__).resolve().parents[1] / "examples" / "specimen.toml"
 SETTLE, RECORD = 100, 50
 
@@ -47,41 +49,17 @@ def scenario() -> ib.Scenario:
     })
 
 
-class KernelClock:
-    """Wall time spent inside the compiled kernels' entry points while it is active (``with`` block)."""
+class SweepClock(KernelClock):
+    """The kernels a bifurcation sweep spends its compiled time in."""
 
     NAMES = {"run": "event loop", "extremum": "extremes of the records", "sample": "strobe sampling"}
 
     def __init__(self) -> None:
-        from impactbeam.solver import kernels
-
-        self.ns = kernels.compiled()
-        self.spent = dict.fromkeys(self.NAMES, 0.0)
-        self.calls = dict.fromkeys(self.NAMES, 0)
-
-    def __enter__(self) -> "KernelClock":
-        self.saved = {name: getattr(self.ns, name) for name in self.NAMES}
-        for name, fn in self.saved.items():
-            setattr(self.ns, name, self._timed(name, fn))
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for name, fn in self.saved.items():
-            setattr(self.ns, name, fn)
-
-    def _timed(self, name: str, fn):
-        def call(*args):
-            t0 = time.perf_counter()
-            try:
-                return fn(*args)
-            finally:
-                self.spent[name] += time.perf_counter() - t0
-                self.calls[name] += 1
-        return call
+        super().__init__(self.NAMES)
 
     def report(self, total: float, periods: int, asked: int) -> None:
         compiled = sum(self.spent.values())
-        for name, label in self.NAMES.items():
+        for name, label in self.names.items():
             print(f"  {label:26s} {self.spent[name]:6.2f} s ({self.calls[name]} calls)")
         print(f"  {'compiled, in all':26s} {compiled:6.2f} s ({compiled / total:.0%}); Python and the rest "
               f"{total - compiled:.2f} s")
@@ -114,7 +92,7 @@ def main() -> None:
           f"(target 1 s), {c_sweep:.2f} s CPU ({t_sweep / n_runs * 1e3:.2f} ms per point; {extended} extended while "
           f"settling, {no_period} without a period); {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     if args.breakdown:  # a second sweep, its kernels timed (the timing wrappers cost microseconds per call)
-        with KernelClock() as clock:
+        with SweepClock() as clock:
             t0 = time.perf_counter()
             again = ib.frequency_response(sc, freqs, sweep="both", settle_periods=SETTLE, record_periods=RECORD)
             t_again = time.perf_counter() - t0

@@ -49,6 +49,7 @@ from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
 import impactbeam as ib  # noqa: E402
+from _kernel_clock import KernelClock  # noqa: E402
 
 CASE = Path(__file__).resolve().parents[1] / "examples" / "case03.toml"
 
@@ -167,29 +168,13 @@ def _median_cpu(fn, repeats: int) -> float:
 
 def _split(sc: ib.Scenario, repeats: int) -> dict[str, float]:
     """CPU per ``simulate(sc).metrics()`` in the compiled loop, the compiled metrics and the rest (Python)."""
-    from impactbeam.solver import kernels
-
-    K = kernels.compiled()
-    spent = {"loop": 0.0, "metrics": 0.0}
-    loop, metrics = K.run, K.run_metrics
-
-    def timed(fn, key):
-        def call(*a):
-            c0 = time.process_time()
-            out = fn(*a)
-            spent[key] += time.process_time() - c0
-            return out
-        return call
-
     ib.simulate(sc).metrics()
-    K.run, K.run_metrics = timed(loop, "loop"), timed(metrics, "metrics")
-    try:
+    with KernelClock({"run": "loop", "run_metrics": "metrics"}, clock=time.process_time) as clock:
         c0 = time.process_time()
         for _ in range(repeats):
             ib.simulate(sc).metrics()
         total = time.process_time() - c0
-    finally:
-        K.run, K.run_metrics = loop, metrics
+    spent = {"loop": clock.spent["run"], "metrics": clock.spent["run_metrics"]}
     out = {k: v / repeats for k, v in spent.items()}
     out["python"] = total / repeats - out["loop"] - out["metrics"]
     out["total"] = total / repeats
