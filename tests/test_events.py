@@ -137,3 +137,43 @@ def test_bad_auto_settings(value, match):
     key = "solver.tolerance" if match == "solver.tolerance" else "solver.modes"
     with pytest.raises(ib.ParameterError, match=match):
         ib.load_scenario(EXAMPLES / "case03.toml").with_values({key: value})
+
+
+def _ringing(gap: float, damping: Damping, load: Excitation | None = None):
+    """Six modes of a pinned beam released from a mixed state, a stop below at 0.37 L."""
+    beam = _pinned()
+    ms = ib.mode_set(beam, (), 6)
+    a = 0.37
+    W = ms.shapes([a])[:, 0]
+    eta = np.array([1.0, -0.4, 0.3, 0.2, -0.1, 0.05]) * 1e-3
+    deta = np.array([0.5, 0.3, -0.2, 0.4, 0.1, -0.3]) * 1e-3 * ms.omega
+    res = ib.simulate_system(
+        beam, [Contactor(a, 1e5, gap, "below")], damping=damping, excitation=load,
+        initial=InitialCondition(modal_displacement=tuple(eta), modal_velocity=tuple(deta)),
+        options=SolverOptions(modes=6, time_step=1e-3, end_time=0.5),
+    )
+    return res, W, eta, deta, ms.omega, a
+
+
+@pytest.mark.parametrize("damped", [False, True])
+def test_a_stop_out_of_reach_is_skipped_and_one_just_within_reach_is_hit(damped):
+    # The scan skips a segment whose rows are proven clear to its end (each mode's
+    # contribution below sqrt(v^2 + w^2 x^2) / w, its energy never growing): the
+    # free run below takes no scan step at all. Just within reach, the stop must
+    # still be hit: the gap is set 1e-9 m inside the lowest deflection the same
+    # run reaches without contact (its exact extremes, found independently of the
+    # scan by the dense output's branch-and-bound search).
+    damping = Damping(free=0.02, contact=0.02) if damped else Damping(0.0, 0.0)
+    load = Excitation(kind="point_force", shape="harmonic", amplitude=50.0, position=0.6, frequency=37.0)
+    res, W, eta, deta, om, a = _ringing(1.0, damping)
+    reach = float(np.sum(np.abs(W) * np.sqrt(deta**2 + om**2 * eta**2) / om))
+    far, *_ = _ringing(1.01 * reach, damping)
+    assert far.events == [] and far.solution.evaluations == 0
+    for with_load in (None, load):
+        free, *_ = _ringing(1.0, damping, with_load)  # a stop 1 m away: never reached
+        lowest = -float(free.solution.extrema([(a, 0.0, 0.5, -1.0, 0.0, None)])[0, 0])
+        assert free.events == []
+        near, *_ = _ringing(-lowest - 1e-9, damping, with_load)
+        assert near.events and near.events[0].kind == "impact"
+        clear, *_ = _ringing(-lowest + 1e-9, damping, with_load)
+        assert clear.events == []

@@ -50,7 +50,8 @@ from ._jit import njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "sincos", "kernel", "setup", "segment_setup", "state_at",
            "mode_state", "kernels_into", "state_from",
-           "project", "integral_of", "derivatives", "curvature_bound", "jerk_bound", "workspace", "copy_into",
+           "project", "integral_of", "derivatives", "curvature_bound", "clear_to_end", "jerk_bound", "workspace",
+           "copy_into",
            "ipow"]
 
 REG_UNDER = 0
@@ -325,6 +326,44 @@ def jerk_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compi
                 out[c] += k * math.sqrt(dd * dd + o * o * vd * vd)
     for c in range(out.size):
         out[c] *= 1.0 + 1e-12
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def clear_to_end(VH, VD, om, base, PV, Om, tau_end):  # pragma: no cover - compiled
+    """True when every row is proven positive from where ``VH, VD`` hold up to ``tau_end``.
+
+    ``VH, VD``: each coordinate's homogeneous contribution to each row and its
+    slope at some ``tau`` of the segment. By :func:`curvature_bound`'s energy
+    argument a contribution never exceeds ``sqrt(VD^2 + omega^2 VH^2) / omega``
+    after ``tau`` (``omega > 0``; a row with a frequency-free contribution is
+    not proven); the particular part is bounded below term by term on ``[0,
+    tau_end]``. A row proven positive throughout cannot switch, so the scan
+    may skip to the segment's end: the same event-free segment, found in one
+    step instead of one every few periods.
+    """
+    tmax = max(tau_end, 0.0)
+    for c in range(base.size):
+        p = PV[c]
+        low = base[c] + p[0]
+        spread = abs(base[c]) + abs(p[0])
+        poly = tmax * (abs(p[1]) + tmax * (abs(p[2]) + tmax * abs(p[3])))
+        if Om != 0.0:
+            poly += math.sqrt(p[4] * p[4] + p[5] * p[5]) + (abs(p[6]) + abs(p[7])) * tmax
+        low -= poly
+        spread += poly
+        for n in range(om.size):
+            vh = VH[c, n]
+            vd = VD[c, n]
+            if vh != 0.0 or vd != 0.0:
+                o = om[n]
+                if o <= 0.0:
+                    return False
+                env = math.sqrt(vd * vd + o * o * vh * vh) / o
+                low -= env
+                spread += env
+        if low <= 1e-12 * spread:  # round-off margin
+            return False
+    return True
 
 
 @njit(cache=True, nogil=True, _nrt=False)

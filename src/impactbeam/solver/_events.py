@@ -15,7 +15,11 @@ non-positive and on which ``h' < 0`` is proven (the same bound applied to
 ``h'``) holds exactly one root, which Brent's method (SciPy's ``brentq``
 algorithm) locates to ``xtol``. Grazing dips of any depth above the touch
 tolerance are found this way, two crossings inside one step cannot be
-missed, and the scan does not depend on the output time step.
+missed, and the scan does not depend on the output time step. A segment whose
+rows are all proven positive up to its end
+(:func:`~impactbeam.solver._closed.clear_to_end`, at its start and wherever
+the curvature bounds are refreshed) is not stepped further: no event can
+occur in it.
 
 A contactor left on the wrong side of its state by the projection of eq. (12)
 (``h < 0``, only for the contactor switched at the segment start, moving back
@@ -35,7 +39,7 @@ import math
 import numpy as np
 from ._jit import njit
 
-from ._closed import EPS, curvature_bound_at, derivatives, kernel, mode_state, particular
+from ._closed import EPS, clear_to_end, curvature_bound_at, derivatives, kernel, mode_state, particular
 
 __all__ = ["row_at", "row_from", "brent", "safe_step", "first_event", "scan", "departure"]
 
@@ -262,6 +266,8 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
     nc = g.size
     tau = tau0
     used = used0
+    if clear_to_end(VH, VD, om, base, PV, Om, tau_end):
+        return tau_end, -1, used
     while tau < tau_end:
         step = tau_end - tau
         for c in range(nc):
@@ -301,6 +307,8 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
             dg[c] = dgb[c]
         if used % 32 == 0:  # a decaying response earns longer steps
             curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d)
+            if clear_to_end(work_h, work_d, om, base, PV, Om, tau_end):
+                return tau_end, -1, used
         if used - used0 >= budget and tau < tau_end:
             return tau, -2, used
     return tau_end, -1, used
