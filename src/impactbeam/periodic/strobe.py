@@ -254,6 +254,7 @@ class _RecordAnalysis:
     period: int
     impacts_per_period: float
     strobe_point: float
+    at_point: tuple[np.ndarray, np.ndarray]  # w and w_t at strobe_point at the strobe times
     times: np.ndarray
     window: tuple[float, float]
     mismatch: float
@@ -264,11 +265,11 @@ class _RecordAnalysis:
         """The steady state, its extremes over the record searched now."""
         sol = self.result.solution
         x0, (lo, hi) = self.strobe_point, self.window
-        at = sol.sample(np.array([x0]), self.times)
+        w, w_t = self.at_point
         ext = sol.extrema([(x0, lo, hi, 1.0, 0.0, None), (x0, lo, hi, -1.0, 0.0, None)])
         return SteadyState(
             frequency=self.frequency, period=self.period, impacts_per_period=self.impacts_per_period,
-            strobe=at.w[:-1, 0].copy(), strobe_velocity=at.w_t[:-1, 0].copy(), times=self.times[:-1].copy(),
+            strobe=w[:-1].copy(), strobe_velocity=w_t[:-1].copy(), times=self.times[:-1].copy(),
             max=float(ext[0, 0]), min=float(-ext[1, 0]), mismatch=self.mismatch, point=x0, window=self.window,
             result=self.result, settled_after=self.settled_after, warnings=self.warnings,
         )
@@ -286,6 +287,7 @@ def _record_analysis(result: SimulationResult, scenario: Scenario, settle_period
     probes = _probe_points(scenario)
     smp = sol.sample(probes, times)
     x0 = strobe_point(scenario)
+    j0 = int(np.searchsorted(probes, x0))  # one of the probes: its samples are the strobe's
     lo, hi = float(times[0]), float(times[-1])
     warns: list[str] = []
     if result.status != 0:
@@ -315,7 +317,8 @@ def _record_analysis(result: SimulationResult, scenario: Scenario, settle_period
             f"(smallest mismatch {mism:.3g}): {why} after {before} periods; "
             "impacts_per_period is the mean per forcing period"
         )
-    return _RecordAnalysis(result, 1.0 / T, n, float(ipp), x0, times, (lo, hi), float(mism), before, warns)
+    return _RecordAnalysis(result, 1.0 / T, n, float(ipp), x0, (smp.w[:, j0], smp.w_t[:, j0]), times, (lo, hi),
+                           float(mism), before, warns)
 
 
 def _event_arrays(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:

@@ -12,8 +12,13 @@ and evaluate it.
   slopes ``d0, d1`` and the curvature bound ``M`` of
   :func:`~impactbeam.solver._closed.curvature_bound`, no value exceeds
   ``max(u0, u1, A(s_x))`` where ``A(s) = u0 + d0 s + M s^2/2`` meets its
-  mirror from the right end at ``s_x``; sub-intervals that cannot beat the
-  best value found (to ``atol``) are dropped, the others are split, and an
+  mirror from the right end at ``s_x``. With the bound ``M3`` of
+  :func:`~impactbeam.solver._closed.jerk_bound` and the curvatures ``c0, c1``
+  at the ends, ``u''`` stays below ``(c0 + c1 + M3 L)/2`` (used for ``M`` when
+  smaller) and ``u`` below the cubic ``u0 + d0 s + c0 s^2/2 + M3 s^3/6`` on
+  the left half (its mirror on the right), which is what drops the many
+  near-equal peaks of a steady-state record early. Sub-intervals that cannot
+  beat the best value found (to ``atol``) are dropped, the others are split, and an
   interior maximum (slope ``+`` to ``-``) is refined by Brent's method on the
   velocity. The result is the maximum of the N-mode solution to ``atol``,
   not of any sampled grid.
@@ -229,6 +234,30 @@ def _upper(t0, u0, d0, t1, u1, d1, M):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def _cubic_max(u, d, c, m, h):  # pragma: no cover - compiled
+    """Maximum of ``u + d s + c s^2/2 + m s^3/6`` over ``0 <= s <= h`` (``m >= 0``)."""
+    top = max(u, u + h * (d + h * (0.5 * c + h * m / 6.0)))
+    if d > 0.0 and c < 0.0:
+        disc = c * c - 2.0 * m * d
+        if disc >= 0.0:
+            s = 2.0 * d / (math.sqrt(disc) - c)  # the smaller root of the slope: a local maximum
+            if s < h:
+                top = max(top, u + s * (d + s * (0.5 * c + s * m / 6.0)))
+    return top
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _cubic_upper(u0, d0, c0, u1, d1, c1, L, M3):  # pragma: no cover - compiled
+    """Upper bound on ``[t0, t0 + L]`` from value, slope and curvature at both ends and a bound ``M3`` on ``|u'''|``.
+
+    Taylor's theorem from each end over its half: ``u(t0 + s) <= u0 + d0 s +
+    c0 s^2/2 + M3 s^3/6``, and the mirror image from ``t0 + L``.
+    """
+    h = 0.5 * L
+    return max(_cubic_max(u0, d0, c0, M3, h), _cubic_max(u1, -d1, c1, M3, h))
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
     """Row 0 and its first two derivatives at ``tau`` (the second from the equation of motion)."""
     p = PV[0]
@@ -293,9 +322,13 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
         d1 = stack[top, 6]
         c1 = stack[top, 7]
         L = t1 - t0
-        if _upper(t0, u0, d0, t1, u1, d1, M) <= best + atol or L <= xtol:
+        # u'' lies within M3 (t - t0) of c0 and M3 (t1 - t) of c1: local bounds, tighter than M on short intervals
+        m_abs = min(M, 0.5 * (abs(c0) + abs(c1) + M3 * L))
+        m_up = max(0.0, min(m_abs, 0.5 * (c0 + c1 + M3 * L)))
+        if (min(_upper(t0, u0, d0, t1, u1, d1, m_up), _cubic_upper(u0, d0, c0, u1, d1, c1, L, M3)) <= best + atol
+                or L <= xtol):
             continue
-        if (d0 > 0.0 and d1 > 0.0 and d0 + d1 >= M * L) or (d0 < 0.0 and d1 < 0.0 and -(d0 + d1) >= M * L):
+        if (d0 > 0.0 and d1 > 0.0 and d0 + d1 >= m_abs * L) or (d0 < 0.0 and d1 < 0.0 and -(d0 + d1) >= m_abs * L):
             continue  # monotone: the ends hold the maximum
         concave = c0 < 0.0 and c1 < 0.0 and -(c0 + c1) >= M3 * L
         if concave and not (d0 > 0.0 and d1 < 0.0):

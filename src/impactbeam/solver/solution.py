@@ -403,7 +403,8 @@ class Solution(PiecewiseSolution):
         t : ndarray, [s]
             Times.
         """
-        return np.clip(np.searchsorted(self.t0, t, side="right") - 1, 0, max(self.n_segments - 1, 0))
+        idx = np.searchsorted(self.t0, t, side="right") - 1
+        return np.minimum(np.maximum(idx, 0, out=idx), max(self.n_segments - 1, 0), out=idx)
 
     def sample(self, x: np.ndarray, t: np.ndarray, *, modal: bool = False, energy: bool = False) -> Samples:
         x = np.atleast_1d(np.asarray(x, dtype=float))
