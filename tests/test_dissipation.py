@@ -144,7 +144,7 @@ def test_blocks_reproduce_the_matrix_exponential(seed, kind):
     # Both are exact; the difference is round-off amplified by the blocks' conditioning (1e-11).
     from scipy.linalg import expm
 
-    from impactbeam.solver import _closed
+    from impactbeam.solver import _closed, _elementary
     from impactbeam.solver.blocks import slot_arrays
 
     rng = np.random.default_rng(seed)
@@ -183,7 +183,7 @@ def test_blocks_reproduce_the_matrix_exponential(seed, kind):
     lA[:], lB[:], lD[:], lE[:] = y * u0 + au * u1, y * u1, 0.0, 0.0
     _closed.setup(sa.reg, sa.dec, sa.om, lA, lB, lD, lE, 0.0, 0.0, z, dz, h0, dh0, P)
     e, d = np.empty(n), np.empty(n)
-    _closed.state_at(T, sa.reg, sa.dec, sa.wdh, sa.om, h0, dh0, P, 0.0, 0.0, e, d)
+    _closed.state_at(T, sa.reg, sa.dec, sa.wdh, sa.om, h0, dh0, P, 0.0, 0.0, e, d, _elementary.kernel_work(n))
     xb = Gm @ np.concatenate([e, d - au * (u0 + u1 * T)])
     scale = np.concatenate([np.full(n, np.abs(xT[:n]).max()), np.full(n, np.abs(xT[n:]).max())])
     assert np.abs(xb - xT).max() / 1.0 <= 1e-11 * scale.max()

@@ -289,15 +289,17 @@ def test_kernels_given_at_a_segment_end_give_the_bits_of_kernels_computed_there(
     VH, VD, PV = rng.normal(size=(2, 6)), rng.normal(size=(2, 6)), rng.normal(size=(2, 8))
     base = rng.normal(size=2)
     for tau, Om, phi in ((1.25e-4, 0.0, 0.0), (3.7e-3, 210.0, 0.4)):
-        kc, ks = np.empty(6), np.empty(6)
-        K.kernels_into(tau, reg, a, w, kc, ks)
+        kc, ks, kw = np.empty(6), np.empty(6), K.kernel_work(6)
+        K.kernels_into(tau, reg, a, w, kc, ks, kw)
+        for n in range(6):  # all modes at once (SIMD) give each mode's own kernels
+            assert (kc[n], ks[n]) == K.kernel(reg[n], a[n], w[n], tau)
         e1, d1, e2, d2 = (np.empty(6) for _ in range(4))
-        K.state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e1, d1)
+        K.state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e1, d1, kw)
         K.state_from(tau, kc, ks, a, om, h0, dh0, P, Om, phi, e2, d2)
         np.testing.assert_array_equal(e1, e2)
         np.testing.assert_array_equal(d1, d2)
         for c in range(2):
-            assert K.row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi) == \
+            assert K.row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw) == \
                 K.row_from(c, tau, kc, ks, a, om, VH, VD, base, PV, Om, phi)
 
 

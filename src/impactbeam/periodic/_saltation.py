@@ -150,6 +150,7 @@ class _Field:
     def end_state(self, j: int) -> np.ndarray:
         """Modal state at the end of segment ``j`` (closed form of the engine's kernels)."""
         from ..solver._closed import segment_setup, state_at, workspace
+        from ..solver._elementary import kernel_work
 
         sol, pk = self.sol, self.pk
         s, kp = int(sol.slot[j]), int(sol.piece[j])
@@ -162,7 +163,8 @@ class _Field:
                                 h0, dh0, P, lA, lB, lD, lE, AL)
         e = np.empty(pk.n_modes)
         d = np.empty(pk.n_modes)
-        state_at(float(sol.t1[j] - sol.t0[j]), pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], h0, dh0, P, Om, phi, e, d)
+        state_at(float(sol.t1[j] - sol.t0[j]), pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], h0, dh0, P, Om, phi, e, d,
+                 kernel_work(pk.n_modes))
         return np.concatenate([e, d])
 
 

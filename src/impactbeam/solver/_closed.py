@@ -46,6 +46,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from ._elementary import REG_CRITICAL, REG_OVER, REG_UNDER, ROW_C, ROW_S, kernel, kernels_at, sincos
 from ._jit import njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "sincos", "kernel", "setup", "segment_setup", "state_at",
@@ -54,67 +56,8 @@ __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "sincos", "kernel", "s
            "copy_into",
            "ipow"]
 
-REG_UNDER = 0
-REG_CRITICAL = 1
-REG_OVER = 2
 EPS = 2.220446049250313e-16
 NP = 8  # coefficients of a particular part
-
-
-# sin and cos on [-pi/4, pi/4] (Cephes, S. L. Moshier: relative error about 1e-16) and the three-part pi/4 of
-# its argument reduction
-_S = (1.58962301576546568060e-10, -2.50507477628578072866e-8, 2.75573136213857245213e-6,
-      -1.98412698295895385996e-4, 8.33333333332211858878e-3, -1.66666666666666307295e-1)
-_C = (-1.13585365213876817300e-11, 2.08757008419747316778e-9, -2.75573141792967388112e-7,
-      2.48015872888517045348e-5, -1.38888888888730564116e-3, 4.16666666666665929218e-2)
-_DP1, _DP2, _DP3 = 7.85398125648498535156e-1, 3.77489470793079817668e-8, 2.69515142907905952645e-15
-_FOUR_OVER_PI = 1.27323954473516268615
-_REDUCED_MAX = 2.0**28  # 2.7e8: within two units in the last place up to here (tests/test_closed_form.py)
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def sincos(x):  # pragma: no cover - compiled
-    """``(sin x, cos x)`` to within two units in the last place of the C library's values.
-
-    Plain IEEE arithmetic (a polynomial after a three-part reduction by
-    pi/4), no library call: cheaper in the event loop's scans than the C
-    library's ``sincos``, which took about a third of that loop's time
-    (docs/performance.md). Beyond ``|x| = 2**28`` it defers to the library.
-    """
-    ax = abs(x)
-    if not ax <= _REDUCED_MAX:
-        return math.sin(x), math.cos(x)
-    ji = np.int64(ax * _FOUR_OVER_PI)
-    ji += ji & 1
-    j = float(ji)
-    y = ((ax - j * _DP1) - j * _DP2) - j * _DP3
-    q = ji & 7
-    z = y * y
-    ps = y + y * z * (((((_S[0] * z + _S[1]) * z + _S[2]) * z + _S[3]) * z + _S[4]) * z + _S[5])
-    pc = 1.0 - 0.5 * z + z * z * (((((_C[0] * z + _C[1]) * z + _C[2]) * z + _C[3]) * z + _C[4]) * z + _C[5])
-    swap = (q & 2) != 0
-    sn = pc if swap else ps
-    cs = ps if swap else pc
-    if ((q & 4) != 0) != (x < 0.0):
-        sn = -sn
-    if ((q + 2) & 4) != 0:
-        cs = -cs
-    return sn, cs
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def kernel(reg, a, w, tau):  # pragma: no cover - compiled
-    """``(e_C, e_S)`` of one coordinate at ``tau >= 0`` (see the module docstring)."""
-    if reg == REG_UNDER:
-        e = math.exp(-a * tau)
-        sn, cs = sincos(w * tau)
-        return e * cs, e * sn / w
-    if reg == REG_CRITICAL:
-        e = math.exp(-a * tau)
-        return e, e * tau
-    ep = math.exp((w - a) * tau)
-    x = -2.0 * w * tau
-    return 0.5 * ep * (1.0 + math.exp(x)), -0.5 * ep * math.expm1(x) / w
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -197,21 +140,19 @@ def mode_state(eC, eS, a, o, h, dh):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover - compiled
-    """Coordinates ``e`` and rates ``d`` at ``tau`` (filled in place)."""
-    for n in range(om.size):
-        eC, eS = kernel(reg[n], a[n], w[n], tau)
-        pv, pd = particular(P[n], tau, Om, phi)
-        zh, dzh = mode_state(eC, eS, a[n], om[n], h0[n], dh0[n])
-        e[n] = zh + pv
-        d[n] = dzh + pd
+def state_at(tau, reg, a, w, om, h0, dh0, P, Om, phi, e, d, kw):  # pragma: no cover - compiled
+    """Coordinates ``e`` and rates ``d`` at ``tau`` (filled in place; ``kw`` from :func:`kernel_work`)."""
+    kernels_at(tau, reg, a, w, kw)
+    state_from(tau, kw[ROW_C], kw[ROW_S], a, om, h0, dh0, P, Om, phi, e, d)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def kernels_into(tau, reg, a, w, kc, ks):  # pragma: no cover - compiled
-    """Every coordinate's kernels ``(e_C, e_S)`` at ``tau`` into ``kc, ks``."""
+def kernels_into(tau, reg, a, w, kc, ks, kw):  # pragma: no cover - compiled
+    """Every coordinate's kernels ``(e_C, e_S)`` at ``tau`` into ``kc, ks`` (:func:`kernels_at` in ``kw``)."""
+    kernels_at(tau, reg, a, w, kw)
     for n in range(a.size):
-        kc[n], ks[n] = kernel(reg[n], a[n], w[n], tau)
+        kc[n] = kw[ROW_C, n]
+        ks[n] = kw[ROW_S, n]
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -367,16 +308,18 @@ def clear_to_end(VH, VD, om, base, PV, Om, tau_end):  # pragma: no cover - compi
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, out, work_h, work_d):  # pragma: no cover
+def curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, out, work_h, work_d, kw):  # pragma: no cover
     """:func:`curvature_bound` valid on ``[tau, tau_end]``, from the homogeneous parts at ``tau``.
 
     The homogeneous energy only decreases, so the bound tightens as a damped
     response decays; the scan refreshes it as it goes. ``work_h, work_d``
-    are scratch arrays of the shape of ``VH``.
+    are scratch arrays of the shape of ``VH``, ``kw`` that of :func:`kernels_at`.
     """
     rows = out.size
+    kernels_at(tau, reg, a, w, kw)
     for n in range(om.size):
-        eC, eS = kernel(reg[n], a[n], w[n], tau)
+        eC = kw[ROW_C, n]
+        eS = kw[ROW_S, n]
         k1 = eC + a[n] * eS
         k2 = -om[n] * om[n] * eS
         k3 = eC - a[n] * eS

@@ -34,9 +34,10 @@ import numpy as np
 from ._jit import njit
 
 from ._closed import (
-    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, kernel, particular, project, segment_setup,
+    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, particular, project, segment_setup,
     sincos, state_at, workspace,
 )
+from ._elementary import ROW_C, ROW_S, kernel_work, kernels_at
 from ._events import SLOPE, brent
 from ._loop import load_value, to_modal
 
@@ -108,7 +109,7 @@ def sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, w
     dissipated by the engaged contactors' dashpots).
     """
     nm = seg_eta.shape[1]
-    vectors = (np.empty(nm), np.empty(nm), np.empty(nm), np.empty(nm), np.empty(nm))
+    vectors = (np.empty(nm), np.empty(nm), np.empty(nm), np.empty(nm), np.empty(nm), kernel_work(nm))
     _sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, want_modal, want_energy, seg_t0,
             seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, omo, Wc, LW, CW, gen, G, Cd, pw, pre, smask, gap,
             side, kst, dash, pt0, pconst, pslope, pamp, pOm, pphase, workspace(nm), vectors)
@@ -123,7 +124,7 @@ def _sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, 
     nm = seg_eta.shape[1]
     h0, dh0, P = ws[0], ws[1], ws[2]
     AL = ws[7]
-    z, dz, e, d, alpha = vectors
+    z, dz, e, d, alpha, kw = vectors
     cur = -1
     Om = 0.0
     phi = 0.0
@@ -136,7 +137,7 @@ def _sample(tq, segidx, rows, out_rows, out_drows, out_eta, out_deta, energies, 
                              kst, pt0, pconst, pslope, pamp, pOm, pphase, ws)
             cur = j
         tau = tq[i] - seg_t0[j]
-        state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz)
+        state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz, kw)
         if gen[s]:
             alpha_at(AL, tau, Om, phi, alpha)
         to_modal(gen[s], G[s], z, dz, alpha, e, d)
@@ -210,7 +211,7 @@ def sample_row(t, Wq, seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om
                      pconst, pslope, pamp, pOm, pphase, ws)
     tau = t - seg_t0[j]
     nm = seg_eta.shape[1]
-    state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz)
+    state_at(tau, reg[s], dec[s], wdh[s], om[s], h0, dh0, P, Om, phi, z, dz, work[15])
     if gen[s]:
         alpha_at(AL, tau, Om, phi, alpha)
     to_modal(gen[s], G[s], z, dz, alpha, e, d)
@@ -258,8 +259,11 @@ def _cubic_upper(u0, d0, c0, u1, d1, c1, L, M3):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
-    """Row 0 and its first two derivatives at ``tau`` (the second from the equation of motion)."""
+def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover - compiled
+    """Row 0 and its first two derivatives at ``tau`` (the second from the equation of motion).
+
+    ``kw``: the scratch of :func:`~impactbeam.solver._elementary.kernels_at`.
+    """
     p = PV[0]
     u, du = particular(p, tau, Om, phi)
     ddu = 2.0 * p[2] + 6.0 * p[3] * tau
@@ -269,8 +273,12 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - 
         ddu += -Om * Om * (p[4] * sn + p[5] * cs) + p[6] * (-2.0 * Om * sn - Om * Om * tau * cs)
         ddu += p[7] * (2.0 * Om * cs - Om * Om * tau * sn)
     u += base[0]
+    kernels_at(tau, reg, a, w, kw)
+    kc = kw[ROW_C]
+    ks = kw[ROW_S]
     for n in range(om.size):
-        eC, eS = kernel(reg[n], a[n], w[n], tau)
+        eC = kc[n]
+        eS = ks[n]
         an = a[n]
         o2 = om[n] * om[n]
         vh = VH[0, n]
@@ -282,7 +290,7 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - 
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
+def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):
     # pragma: no cover - compiled
     """Branch and bound for the maximum of row 0 on ``[ta, tb]`` (module docstring).
 
@@ -294,8 +302,8 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
     Returns the new best value and its time, NaN when ``best`` was not beaten.
     """
     tbest = np.nan
-    ua, da, ca = _row3(ta, reg, a, w, om, VH, VD, base, PV, Om, phi)
-    ub, db, cb = _row3(tb, reg, a, w, om, VH, VD, base, PV, Om, phi)
+    ua, da, ca = _row3(ta, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+    ub, db, cb = _row3(tb, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
     if ua > best:
         best = ua
         tbest = ta
@@ -335,10 +343,10 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
             continue  # concave with no interior stationary point: the ends hold the maximum
         tm = 0.5 * (t0 + t1)
         if concave:  # the one interior maximum: Brent on u'
-            tm = brent(SLOPE, ROW0, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+            tm = brent(SLOPE, ROW0, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
             if not (t0 < tm < t1):
                 tm = 0.5 * (t0 + t1)
-        um, dm, cm = _row3(tm, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        um, dm, cm = _row3(tm, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
         if um > best:
             best = um
             tbest = tm
@@ -369,7 +377,7 @@ def dense_work(nm):  # pragma: no cover - compiled
     """Work arrays of :func:`extremum_query` and :func:`integral_query` for ``nm`` coordinates."""
     return (workspace(nm), np.empty((1, nm)), np.empty((1, nm)), np.zeros(1), np.empty((1, nm)), np.empty((1, nm)),
             np.empty((1, NP)), np.empty(1), np.empty(1), np.zeros(nm), np.empty(nm), np.empty(nm),
-            np.empty((128, 8)), np.empty(nm), np.empty(nm))
+            np.empty((128, 8)), np.empty(nm), np.empty(nm), kernel_work(nm))
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -417,7 +425,7 @@ def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg
     could not have changed that value, so the result is the same to the bit,
     only sooner.
     """
-    ws, V, U, base, VH, VD, PV, M, M3, alpha, e, d, stack, _, _ = work
+    ws, V, U, base, VH, VD, PV, M, M3, alpha, e, d, stack, _, _, kw = work
     h0, dh0, P = ws[0], ws[1], ws[2]
     AL = ws[7]
     nm = seg_eta.shape[1]
@@ -467,7 +475,7 @@ def extremum_query(lo, hi, sign, offset, rate, Wq, cond, atol, xtol, seg_t0, seg
         curvature_bound(VH, VD, dec[s], om[s], PV, Om, L, M)
         jerk_bound(VH, VD, dec[s], om[s], PV, Om, L, M3)
         best, tloc = _segment_max(a0 - seg_t0[j], L, M[0], M3[0], best, atol, xtol,
-                                  stack, reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi)
+                                  stack, reg[s], dec[s], wdh[s], om[s], VH, VD, base, PV, Om, phi, kw)
         if not np.isnan(tloc):
             tbest = tloc + seg_t0[j]
     return best, tbest

@@ -39,7 +39,8 @@ import math
 import numpy as np
 from ._jit import njit
 
-from ._closed import EPS, clear_to_end, curvature_bound_at, derivatives, kernel, mode_state, particular
+from ._closed import EPS, clear_to_end, curvature_bound_at, derivatives, mode_state, particular
+from ._elementary import ROW_C, ROW_S, kernels_at
 
 __all__ = ["row_at", "row_from", "brent", "safe_step", "first_event", "scan", "departure"]
 
@@ -52,17 +53,10 @@ SLOPE = np.int64(1)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
-    """``(h_c, h_c')`` of one row at ``tau``."""
-    pv, pd = particular(PV[c], tau, Om, phi)
-    g = base[c] + pv
-    dg = pd
-    for n in range(om.size):
-        eC, eS = kernel(reg[n], a[n], w[n], tau)
-        zh, dzh = mode_state(eC, eS, a[n], om[n], VH[c, n], VD[c, n])
-        g += zh
-        dg += dzh
-    return g, dg
+def row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover - compiled
+    """``(h_c, h_c')`` of one row at ``tau`` (``kw``: the scratch of :func:`~impactbeam.solver._elementary.kernels_at`)."""
+    kernels_at(tau, reg, a, w, kw)
+    return row_from(c, tau, kw[ROW_C], kw[ROW_S], a, om, VH, VD, base, PV, Om, phi)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -79,13 +73,13 @@ def row_from(c, tau, kc, ks, a, om, VH, VD, base, PV, Om, phi):  # pragma: no co
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _f(which, c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover - compiled
-    g, dg = row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi)
+def _f(which, c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover - compiled
+    g, dg = row_at(c, tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
     return g if which == 0 else dg
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi):  # pragma: no cover
+def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover
     """Root of ``h_c`` (which = 0) or ``h_c'`` (which = 1) in ``[xa, xb]`` bracketing a sign change.
 
     SciPy's ``brentq`` algorithm (``xtol`` absolute, ``4 eps`` relative).
@@ -141,7 +135,7 @@ def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, p
             xcur += scur
         else:
             xcur += delta if sbis > 0.0 else -delta
-        fcur = _f(which, c, xcur, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        fcur = _f(which, c, xcur, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
     return xcur
 
 
@@ -167,7 +161,8 @@ def _monotone(d0, d1, M, L, sign):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, om, VH, VD, base, PV, Om, phi):
+def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, om, VH, VD, base, PV, Om, phi,
+                kw):
     # pragma: no cover - compiled
     """First switching time of row ``c`` in ``(ta, tb]``, or NaN (see the module docstring).
 
@@ -199,7 +194,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
                 if M <= 0.0 or safe_step(g0 + tol_h, d0, M) + safe_step(g1 + tol_h, -d1, M) >= L:
                     continue
             elif not touch0 and (_monotone(d0, d1, M, L, -1.0) or L <= xtol):
-                return brent(VALUE, c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
+                return brent(VALUE, c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
             elif touch0 and L <= xtol:
                 return t0  # from the surface straight into the stop
             if L <= xtol:
@@ -210,8 +205,8 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
             if _monotone(d0, d1, M, L, 1.0) or _monotone(d0, d1, M, L, -1.0):
                 continue  # monotone: no turn-back inside, at most an upward crossing
             if d0 > 0.0 and d1 <= 0.0 and (L <= xtol or g1 <= 0.0):
-                r = brent(SLOPE, c, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi)
-                gr, dr = row_at(c, r, reg, a, w, om, VH, VD, base, PV, Om, phi)
+                r = brent(SLOPE, c, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+                gr, dr = row_at(c, r, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
                 if gr <= 0.0:
                     return r
                 # it rose above zero and came back: look for the downward crossing after r
@@ -228,7 +223,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
         if top + 2 > stack.shape[0]:
             continue  # deeper than the stack: the interval is below any resolvable scale
         tm = 0.5 * (t0 + t1)
-        gm, dm = row_at(c, tm, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        gm, dm = row_at(c, tm, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
         stack[top, 0] = tm  # right half, examined after the left one
         stack[top, 1] = gm
         stack[top, 2] = dm
@@ -247,7 +242,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
 
 @njit(cache=True, nogil=True, _nrt=False)
 def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, stack, reg, a, w, om, VH, VD, base, PV,
-         Om, phi, work_h, work_d, kc, ks):
+         Om, phi, work_h, work_d, kc, ks, kw):
     # pragma: no cover - compiled
     """Advance from ``tau0`` to the first switching event before ``tau_end``.
 
@@ -285,17 +280,19 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
         tb = tau + step
         if tb <= tau:
             tb = tau_end
-        for c in range(nc):
-            if tb == tau_end:  # the kernels at the segment's end are given
+        if tb == tau_end:  # the kernels at the segment's end are given
+            for c in range(nc):
                 gb[c], dgb[c] = row_from(c, tb, kc, ks, a, om, VH, VD, base, PV, Om, phi)
-            else:
-                gb[c], dgb[c] = row_at(c, tb, reg, a, w, om, VH, VD, base, PV, Om, phi)
+        else:  # the kernels once for every row
+            kernels_at(tb, reg, a, w, kw)
+            for c in range(nc):
+                gb[c], dgb[c] = row_from(c, tb, kw[ROW_C], kw[ROW_S], a, om, VH, VD, base, PV, Om, phi)
         used += 1
         best = np.inf
         which = -1
         for c in range(nc):
             r = first_event(c, tau, g[c], dg[c], tb, gb[c], dgb[c], M[c], xtol, tol_h, stack,
-                            reg, a, w, om, VH, VD, base, PV, Om, phi)
+                            reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
             if not np.isnan(r) and r < best:
                 best = r
                 which = c
@@ -306,7 +303,7 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
             g[c] = gb[c]
             dg[c] = dgb[c]
         if used % 32 == 0:  # a decaying response earns longer steps
-            curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d)
+            curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d, kw)
             if clear_to_end(work_h, work_d, om, base, PV, Om, tau_end):
                 return tau_end, -1, used
         if used - used0 >= budget and tau < tau_end:

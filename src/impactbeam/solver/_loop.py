@@ -62,6 +62,7 @@ from ._closed import (
     NP, alpha_at, copy_into, curvature_bound, kernels_into, particular, project, segment_setup, state_at, state_from,
     workspace,
 )
+from ._elementary import kernel_work
 from ._events import departure, scan
 
 from ._codes import (  # noqa: E402 - status codes and the carry's layout, shared with the Python side
@@ -321,7 +322,7 @@ def run(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, t
                np.empty(nrm), np.empty(nrm), np.empty(KMAX + 1), np.empty(KMAX + 1), np.empty(nm), np.empty(nm))
     matrices = (P, AL, np.empty((nrm, nm)), np.empty((nrm, nm)), np.empty((nrm, nm)), np.empty((nrm, nm)),
                 np.empty((nrm, nm)), np.empty((nrm, nm)), np.empty((nrm, NP)), np.empty((96, 6)),
-                np.empty((3, max(nm, gap.size))), np.empty((2, KMAX + 2)))
+                np.empty((3, max(nm, gap.size))), np.empty((2, KMAX + 2)), kernel_work(nm))
     rows = (np.empty(nrm, dtype=np.int64), np.empty(nrm, dtype=np.int64))
     return _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from, tr_to, gap, side, kst, dash,
                  pt0, pt1, pconst, pslope, pamp, pOm, pphase, T_end, tol_h, xtol, max_events, budget, fc, ic, eta,
@@ -340,7 +341,7 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
     nc = gap.size
     nrm = 2 * nc
     h0, dh0, lA, lB, lD, lE, alpha, base, g, dg, gb, dgb, M, dvec, mag, kc, ks = vectors
-    P, AL, V, U, VH, VD, WH, WD, PV, stack, work, dwork = matrices
+    P, AL, V, U, VH, VD, WH, WD, PV, stack, work, dwork, kw = matrices
     rowc, rowk = rows
     evals = 0
     k_slot = -1  # the slot and segment length of the kernels in kc, ks: equal lengths (a sampled load) share them
@@ -407,12 +408,12 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
             wmax = max(wmax, om_s[n])
         dmin = math.pi / (4.0 * wmax) if wmax > 0.0 else tau_end
         if s != k_slot or tau_end != k_tau:
-            kernels_into(tau_end, reg_s, dec_s, wdh_s, kc, ks)
+            kernels_into(tau_end, reg_s, dec_s, wdh_s, kc, ks, kw)
             k_slot = s
             k_tau = tau_end
         tau_e, ch, used = scan(tau0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h, used0,
                                budget - evals, stack, reg_s, dec_s, wdh_s, om_s, VH[:nr], VD[:nr], base[:nr],
-                               PV[:nr], Om, phi, WH[:nr], WD[:nr], kc, ks)
+                               PV[:nr], Om, phi, WH[:nr], WD[:nr], kc, ks, kw)
         evals += used - used0
         ic[I_EVALS] += used - used0
         if ch == -2:  # budget spent inside the segment: keep the scan's place and report
@@ -437,7 +438,7 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
             if ch == -1:  # te - t = tau_end: its kernels are at hand
                 state_from(tau_end, kc, ks, dec_s, om_s, h0, dh0, P, Om, phi, eta, deta)
             else:
-                state_at(te - t, reg_s, dec_s, wdh_s, om_s, h0, dh0, P, Om, phi, eta, deta)
+                state_at(te - t, reg_s, dec_s, wdh_s, om_s, h0, dh0, P, Om, phi, eta, deta, kw)
         fc[F_T] = te
         if ch >= 0:
             c = rowc[ch]

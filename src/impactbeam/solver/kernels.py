@@ -47,7 +47,7 @@ __all__ = ["Kernels", "active", "for_work", "compiled", "interpreted", "ready", 
 _LOG = logging.getLogger("impactbeam")
 _PACKAGE = __name__.rsplit(".", 1)[0]  # impactbeam.solver
 _TWIN = _PACKAGE + "._interpreted"
-_MODULES = ("_closed", "_events", "_loop", "_dense", "_metrics", "_batch")
+_MODULES = ("_elementary", "_closed", "_events", "_loop", "_dense", "_metrics", "_batch")
 #: The kernels called from Python, (module, function): what the cache must hold for :func:`ready`.
 ENTRY_POINTS = (("_loop", "run"), ("_dense", "sample"), ("_dense", "extremum"), ("_dense", "integral"),
                 ("_metrics", "run_metrics"), ("_batch", "run_batch"))
