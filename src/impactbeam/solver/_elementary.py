@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import COMPILED, njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "sincos", "exponential", "kernel", "kernels_at", "kernel_work"]
 
@@ -152,9 +152,15 @@ def kernels_at(tau, reg, a, w, kw):  # pragma: no cover - compiled
     :func:`kernel`, which gives the same numbers where both apply.
     Compiled with NumPy's error model: Python's checks every divisor (to
     raise ZeroDivisionError), which keeps the compiler from vectorising;
-    the divisors here are under-damped frequencies and the pads' 1.0.
+    the divisors here are under-damped frequencies and the pads' 1.0. The
+    interpreted twin calls :func:`kernel` mode by mode: the same numbers,
+    in a fraction of the Python operations.
     """
     nm = a.size
+    if not COMPILED:
+        for i in range(nm):
+            kw[ROW_C, i], kw[ROW_S, i] = kernel(reg[i], a[i], w[i], tau)
+        return
     ka = kw[ROW_A]
     kf = kw[ROW_W]
     kcos = kw[ROW_C]

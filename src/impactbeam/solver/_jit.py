@@ -21,4 +21,8 @@ from __future__ import annotations
 
 from numba import njit
 
-__all__ = ["njit"]
+__all__ = ["njit", "COMPILED"]
+
+#: False in the interpreted twins: a kernel may then take a path that is cheaper for Python and gives the
+#: same bits (numba folds the constant, so the compiled code has only its own path).
+COMPILED = True

@@ -175,6 +175,7 @@ def interpreted() -> Kernels:
             pkg.__path__ = [os.path.dirname(__file__)]  # type: ignore[attr-defined]
             jit = types.ModuleType(_TWIN + "._jit")
             jit.njit = _identity  # type: ignore[attr-defined]
+            jit.COMPILED = False  # type: ignore[attr-defined]
             sys.modules[_TWIN] = pkg
             sys.modules[_TWIN + "._jit"] = jit
         ns = _namespace(_TWIN, True)
