@@ -52,7 +52,8 @@ from ._jit import njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "sincos", "kernel", "setup", "segment_setup", "state_at",
            "mode_state", "kernels_into", "state_from",
-           "project", "integral_of", "derivatives", "curvature_bound", "clear_to_end", "jerk_bound", "workspace",
+           "project", "integral_of", "derivatives", "curvature_bound", "particular_spread",
+           "clear_to_end", "jerk_bound", "workspace",
            "copy_into",
            "ipow"]
 
@@ -270,14 +271,21 @@ def jerk_bound(VH, VD, a, om, PV, Om, tau_end, out):  # pragma: no cover - compi
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def clear_to_end(VH, VD, om, base, PV, Om, tau_end):  # pragma: no cover - compiled
+def particular_spread(p, L):  # pragma: no cover - compiled
+    """Bound on ``|P(tau) - p[0]|`` over ``0 <= tau <= L`` for the particular part ``p``, term by term."""
+    return (L * (abs(p[1]) + L * (abs(p[2]) + L * abs(p[3]))) + math.sqrt(p[4] * p[4] + p[5] * p[5])
+            + L * math.sqrt(p[6] * p[6] + p[7] * p[7]))
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def clear_to_end(VH, VD, om, base, PV, tau_end):  # pragma: no cover - compiled
     """True when every row is proven positive from where ``VH, VD`` hold up to ``tau_end``.
 
     ``VH, VD``: each coordinate's homogeneous contribution to each row and its
     slope at some ``tau`` of the segment. By :func:`curvature_bound`'s energy
     argument a contribution never exceeds ``sqrt(VD^2 + omega^2 VH^2) / omega``
     after ``tau`` (``omega > 0``; a row with a frequency-free contribution is
-    not proven); the particular part is bounded below term by term on ``[0,
+    not proven); the particular part by :func:`particular_spread` on ``[0,
     tau_end]``. A row proven positive throughout cannot switch, so the scan
     may skip to the segment's end: the same event-free segment, found in one
     step instead of one every few periods.
@@ -285,13 +293,9 @@ def clear_to_end(VH, VD, om, base, PV, Om, tau_end):  # pragma: no cover - compi
     tmax = max(tau_end, 0.0)
     for c in range(base.size):
         p = PV[c]
-        low = base[c] + p[0]
-        spread = abs(base[c]) + abs(p[0])
-        poly = tmax * (abs(p[1]) + tmax * (abs(p[2]) + tmax * abs(p[3])))
-        if Om != 0.0:
-            poly += math.sqrt(p[4] * p[4] + p[5] * p[5]) + (abs(p[6]) + abs(p[7])) * tmax
-        low -= poly
-        spread += poly
+        poly = particular_spread(p, tmax)
+        low = base[c] + p[0] - poly
+        spread = abs(base[c]) + abs(p[0]) + poly
         for n in range(om.size):
             vh = VH[c, n]
             vd = VD[c, n]

@@ -34,8 +34,8 @@ import numpy as np
 from ._jit import njit
 
 from ._closed import (
-    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, particular, project, segment_setup,
-    sincos, state_at, workspace,
+    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, particular, particular_spread, project,
+    segment_setup, sincos, state_at, workspace,
 )
 from ._elementary import ROW_C, ROW_S, kernel_work, kernels_at
 from ._events import SLOPE, brent
@@ -387,13 +387,13 @@ def row_ceiling(VH, VD, PV, base, reg, a, wd, L):  # pragma: no cover - compiled
     A homogeneous contribution ``f`` (value ``VH``, slope ``VD`` at 0, decay
     ``a >= 0``) never exceeds ``sqrt(VH^2 + ((VD + a VH) / w_d)^2)`` when
     under-damped, nor ``|VH| + |VD + a VH| L`` otherwise (``e^{-a tau}`` times
-    cos/sin, 1/tau or cosh/sinh, each bounded so); the particular part is
-    bounded term by term.
+    cos/sin, 1/tau or cosh/sinh, each bounded so); the particular part by
+    :func:`~impactbeam.solver._closed.particular_spread`.
     """
     p = PV[0]
-    up = base[0] + p[0] + abs(p[1]) * L + (abs(p[2]) + abs(p[3]) * L) * L * L
-    up += math.sqrt(p[4] * p[4] + p[5] * p[5]) + L * math.sqrt(p[6] * p[6] + p[7] * p[7])
-    mag = abs(base[0]) + abs(up - base[0])
+    spread = particular_spread(p, L)
+    up = base[0] + p[0] + spread
+    mag = abs(base[0]) + abs(p[0]) + spread
     for n in range(wd.size):
         if a[n] < 0.0:
             return np.inf, np.inf  # a growing coordinate: no ceiling (never so: damping dissipates)

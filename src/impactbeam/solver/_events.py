@@ -261,7 +261,7 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
     nc = g.size
     tau = tau0
     used = used0
-    if clear_to_end(VH, VD, om, base, PV, Om, tau_end):
+    if clear_to_end(VH, VD, om, base, PV, tau_end):
         return tau_end, -1, used
     while tau < tau_end:
         step = tau_end - tau
@@ -304,7 +304,7 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
             dg[c] = dgb[c]
         if used % 32 == 0:  # a decaying response earns longer steps
             curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d, kw)
-            if clear_to_end(work_h, work_d, om, base, PV, Om, tau_end):
+            if clear_to_end(work_h, work_d, om, base, PV, tau_end):
                 return tau_end, -1, used
         if used - used0 >= budget and tau < tau_end:
             return tau, -2, used
