@@ -87,10 +87,12 @@ def main() -> None:
     n_runs = len(fr.frequency)
     no_period = int(np.sum(fr.period == 0))
     extended = sum(p.state.settled_after > SETTLE for p in fr.diagram.points)
+    no_impact = sum(p.state.impacts_per_period == 0 for p in fr.diagram.points)
     print(f"specimen, gap 0.1 mm, 2 g harmonic base acceleration, {SETTLE} settle + {RECORD} recorded periods")
     print(f"exact engine: {args.points} frequencies up and down = {n_runs} steady states in {t_sweep:.2f} s "
           f"(target 1 s), {c_sweep:.2f} s CPU ({t_sweep / n_runs * 1e3:.2f} ms per point; {extended} extended while "
-          f"settling, {no_period} without a period); {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
+          f"settling, {no_period} without a period, {no_impact} without an impact in their record); "
+          f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     if args.breakdown:  # a second sweep, its kernels timed (the timing wrappers cost microseconds per call)
         with SweepClock() as clock:
             t0 = time.perf_counter()
