@@ -24,6 +24,12 @@ It exists so the tests can check the exact solver against an integrator
 that shares none of its propagation or event-location code. It is about
 two orders of magnitude slower.
 
+A contactor the projection of eq. (12) leaves on the wrong side of its new
+state (its row below ``-1e-12 L``) is judged at the restart by the engine's
+rule: it switches at once unless it is the contactor just switched and is
+moving back towards its side; then it switches where its row turns back
+(a terminal event on the row's slope), unless the row reaches 0 first.
+
 Limitations (those of :func:`scipy.integrate.solve_ivp`): events are found
 from sign changes between accepted steps, so a graze that dips below the
 surface and back within one step is missed; the step is bounded by
@@ -234,6 +240,43 @@ class _Reference:
                 rows.append((c, "phase"))
         return evs, rows
 
+    def _judge_start(self, evs: list, rows: list, t: float, y0: np.ndarray, rhs, just: int | None,
+                     judged: dict[int, int]) -> tuple[list[int], list[int]]:
+        """Rows on the wrong side at a restart: those to switch at once, and those to switch where they turn.
+
+        The engine's rule (:mod:`~impactbeam.solver._loop`): a row below
+        ``-1e-12 L`` switches at once, unless it belongs to the contactor just
+        switched (``just``) and is moving back towards its side, or this rule
+        already switched its contactor twice at this instant (``judged``); those
+        switch where their slope turns negative while they are still at or below 0.
+        """
+        tol = 1e-12 * self.beam.length
+        wrong, turns = [], []
+        for r, ev in enumerate(evs):
+            if ev(t, y0) >= -tol:
+                continue
+            back = rows[r][0] == just and rows[r][1] == "main" and self._slope_event(ev, rhs)(t, y0) >= 0.0
+            if not back and judged.get(rows[r][0], 0) < 2:
+                wrong.append(r)
+            else:
+                turns.append(r)
+        return wrong, turns
+
+    @staticmethod
+    def _slope_event(ev, rhs):
+        """Terminal event on the time derivative of the (affine) row ``ev`` along the flow, crossing down."""
+        y_ref = None
+
+        def slope(tt, y):
+            nonlocal y_ref
+            if y_ref is None or y_ref.shape != y.shape:
+                y_ref = np.zeros_like(y)
+            return ev(tt, rhs(tt, y)) - ev(tt, y_ref)  # the row is affine in y: its linear part on y'
+
+        slope.terminal = True
+        slope.direction = -1.0
+        return slope
+
     def energy(self, st: StateModel, eta: np.ndarray, deta: np.ndarray) -> float:
         """Kinetic + strain (beam, supports) + engaged contactor springs ``1/2 k g^2``."""
         E = 0.5 * float(deta @ deta) + 0.5 * float(np.sum((st.modes.omega * eta) ** 2))
@@ -286,6 +329,9 @@ class _Reference:
         pens: list[float] = []
         last_t = -1.0
         atol_state: dict[tuple[int, ...], np.ndarray] = {}
+        just: int | None = None  # the contactor switched at the current restart
+        judged: dict[int, int] = {}  # switches made at once by _judge_start at the instant judged_t
+        judged_t = -1.0
         while t < T:
             while breaks[k_break] <= t:
                 k_break += 1
@@ -304,9 +350,17 @@ class _Reference:
             y0 = np.concatenate([eta, deta])
             if engaged not in atol_state:
                 atol_state[engaged] = self.atol(st, y0)
-            # the initial state penetrates a stop (or a released dashpot pulls): switch at t = 0, as the
-            # engine does; later, a state left slightly inconsistent by eq. (12) is let run as before
-            wrong = [r for r, ev in enumerate(evs) if ev(t, y0) < -1e-12 * self.beam.length] if t == 0.0 else []
+            if t != judged_t:
+                judged, judged_t = {}, t
+            wrong, turns = self._judge_start(evs, rows, t, y0, rhs, just, judged)
+            if wrong and rows[wrong[0]][1] == "phase":
+                phase[rows[wrong[0]][0]] = False  # the penetration left by a release is gone: a plain opening
+                continue
+            turned: dict[int, int] = {}  # event index -> the row on the wrong side it watches turn back
+            for r in turns:
+                turned[len(evs)] = r
+                evs.append(self._slope_event(evs[r], rhs))
+                rows.append((rows[r][0], "turn"))
             if wrong:
                 sol = None
             else:
@@ -319,6 +373,7 @@ class _Reference:
             hit: tuple[float, int] | None = None
             if sol is None:
                 hit = (t, wrong[0])
+                judged[rows[wrong[0]][0]] = judged.get(rows[wrong[0]][0], 0) + 1
             elif sol.status == 1:
                 for r, te in enumerate(sol.t_events):
                     if te.size and (hit is None or te[0] < hit[0]):
@@ -329,6 +384,10 @@ class _Reference:
                 segments.append(IvpSegment(t, t1, engaged, IvpDense(sol.sol, t, t1, y0, y1)))
             eta, deta = y1[:n].copy(), y1[n:].copy()
             t = t1
+            just = None
+            if hit is not None and hit[1] in turned:  # turned back: a switch if still on the wrong side
+                r = turned[hit[1]]
+                hit = (t, r) if evs[r](t, y1) <= 0.0 else None  # else it reached its side first: a restart
             if hit is not None and rows[hit[1]][1] == "phase":
                 phase[rows[hit[1]][0]] = False  # the penetration left by a release is gone
             elif hit is not None:
@@ -350,6 +409,7 @@ class _Reference:
                 P = self.space.transfer(new, engaged, self.opt.projection == "contact")
                 eta, deta = P @ eta, P @ deta
                 engaged = new
+                just = c
                 jumps.append(self.energy(self.space.state(new), eta, deta) - E_before)
                 if len(events) >= self.opt.max_events or same_instant[c] > 4:
                     status = 1
