@@ -306,3 +306,24 @@ def test_shooting_refuses_non_proportional_states():
     sc = sc.with_values({"contactors.0.damping": 0.5})
     with pytest.raises(ParameterError, match="dashpots"):
         ib.periodic_orbit(sc)
+
+
+def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
+    # Rayleigh beta = 1e-4 s on the enriched basis of a dashpot stop: the over-damped high coordinates all
+    # decay near 1/beta, so the block coordinates of that state are nearly dependent and cannot carry the
+    # state exactly. The refusal says which state, why, and what runs it (the solve_ivp path does).
+    L = 0.1092
+    sc = ib.parse_scenario({
+        "beam": {"length": L, "width": 9.93e-3, "height": 3.03e-3, "youngs_modulus": 1834e6, "density": 951.98},
+        "supports": {"left": {"translational": 1e3, "rotational": 0.0}, "right": "sliding"},
+        "masses": [{"position_ratio": 0.976, "mass": 1e-3, "rotary_inertia": 1e-9}],
+        "contactors": [
+            {"position_ratio": 0.454, "stiffness": 316534.85, "gap": 1e-5, "side": "above", "restitution": 0.3},
+            {"position_ratio": 0.676, "stiffness": 412.313, "gap": 1e-5, "side": "below", "damping": 0.136595},
+            {"position_ratio": 0.873, "stiffness": 941.534, "gap": 0.0, "side": "below"}],
+        "damping": {"model": "rayleigh", "alpha": 0.0, "beta": 1e-4},
+        "excitation": {"kind": "point_force", "shape": "step", "amplitude": -0.2, "position": 0.01704},
+        "solver": {"modes": 4, "time_step": 1e-5, "end_time": 0.02},
+    })
+    with pytest.raises(ib.SimulationError, match=r'the state with contactors 1 engaged: .*1/beta.*method = "ivp"'):
+        ib.simulate(sc)

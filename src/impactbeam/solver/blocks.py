@@ -69,6 +69,16 @@ class SlotArrays:
     residual: float = 0.0
 
 
+def _clustered(rates: np.ndarray) -> int:
+    """How many of ``rates`` lie within 1 % of another one."""
+    r = np.sort(np.asarray(rates, dtype=float))
+    close = np.abs(np.diff(r)) <= 0.01 * np.maximum(np.abs(r[1:]), 1e-300)
+    near = np.zeros(r.size, dtype=bool)
+    near[1:] |= close
+    near[:-1] |= close
+    return int(np.count_nonzero(near))
+
+
 def _regimes(om: np.ndarray, dec: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Regime codes (0 under, 1 critical, 2 over) and damped frequencies."""
     disc = om**2 - dec**2
@@ -267,7 +277,13 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
     reg, wdh = _regimes(om, dec)
     Hm = np.linalg.inv(Gm)
     if np.linalg.norm(Hm @ Gm - np.eye(2 * n), np.inf) > 1e-6:
-        raise SimulationError("non-proportional damping: the state's coordinates are too ill-conditioned")
+        slow = dec[(reg == 2)] - wdh[(reg == 2)]  # the slower rate of each over-damped coordinate
+        raise SimulationError(
+            "non-proportional damping: the state's coordinates are too ill-conditioned to integrate exactly "
+            f"({_clustered(slow)} over-damped coordinates decay at rates within 1 % of another's: stiffness-"
+            "proportional damping of high modes, e.g. Rayleigh beta, puts them all near 1/beta); lower that "
+            'damping or the mode count, or run method = "ivp"'
+        )
     G = np.stack([Gm[:, :n], Gm[:, n:]])
     H = np.stack([Hm[:n], Hm[n:]])
     # loads: the modal force f enters x' as [0; f]; on the blocks (alpha, beta) = H [0; f]

@@ -33,6 +33,7 @@ from ..modal import mode_set
 from . import _codes as _loop, kernels
 from ..model import Damping, SolverOptions
 from .solution import Solution
+from ..exceptions import SimulationError
 from .blocks import classical_slot, slot_arrays
 from .initial import initial_coordinates
 from .states import StateModel, StateSpace, _preload_key
@@ -161,7 +162,11 @@ class _Packed:
         if st.damping_matrix is None:
             sa = classical_slot(omega, st.dyn.decay, st.W_contact, st.load_weights, st.preload_weights)
         else:
-            sa = slot_arrays(omega, st.damping_matrix, st.W_contact, st.load_weights, st.preload_weights)
+            try:
+                sa = slot_arrays(omega, st.damping_matrix, st.W_contact, st.load_weights, st.preload_weights)
+            except SimulationError as exc:
+                what = f"contactors {', '.join(map(str, key))} engaged" if key else "no contactor engaged"
+                raise SimulationError(f"the state with {what}: {exc}") from None
         for name in ("reg", "dec", "wdh", "om", "LW", "CW", "RW", "G", "H", "Cd"):
             getattr(self, name)[s] = getattr(sa, name)
         self.gen[s] = sa.gen
