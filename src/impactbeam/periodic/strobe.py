@@ -18,6 +18,7 @@ with a warning.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -156,13 +157,41 @@ def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
     if s.ndim == 1:
         s = s[:, None]
     top = (s.shape[0] - 1) // 2 if max_period is None else min(int(max_period), s.shape[0] - 1)
-    best = math.inf
-    for n in range(1, max(top, 0) + 1):
-        mism = float(np.max(np.abs(s[n:] - s[:-n]))) if s.shape[0] > n else math.inf
-        if mism <= tolerance:
-            return n, mism
-        best = min(best, mism)
-    return 0, best
+    if top < 1:
+        return 0, math.inf
+    mism = float(np.max(np.abs(s[1:] - s[:-1])))  # period 1 alone first: a settled linear response has it
+    if mism <= tolerance:
+        return 1, mism
+    later = _lag_mismatches(s, top) if top > 1 else np.empty(0)  # the longer periods in one pass, same numbers
+    hit = np.flatnonzero(later <= tolerance)
+    if hit.size:
+        return int(hit[0]) + 2, float(later[hit[0]])
+    tried = np.concatenate([[mism], later])
+    tried = tried[~np.isnan(tried)]  # a run that stopped early samples NaN after its end: those lags never count
+    return 0, float(np.min(tried)) if tried.size else math.inf
+
+
+def _lag_mismatches(s: np.ndarray, top: int) -> np.ndarray:
+    """``max_k |s_{k+n} - s_k|`` for ``n = 2 .. top`` (``top < len(s)``), from one gather of the sample pairs."""
+    first, second, starts = _lag_pairs(s.shape[0], top)
+    cols = np.ascontiguousarray(s.T)  # components along rows: NumPy reduces long contiguous rows fast
+    d = np.take(cols, second, axis=1)
+    d -= np.take(cols, first, axis=1)
+    np.abs(d, out=d)
+    return np.maximum.reduceat(d, starts, axis=1).max(axis=0)
+
+
+@functools.lru_cache(maxsize=32)
+def _lag_pairs(n_samples: int, top: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Indices ``(k, k + n)`` of every pair at lags ``n = 2 .. top``, lag by lag, and where each lag starts."""
+    lags = np.arange(2, top + 1)
+    counts = n_samples - lags
+    first = np.concatenate([np.arange(c) for c in counts])
+    second = first + np.repeat(lags, counts)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    for a in (first, second, starts):
+        a.flags.writeable = False
+    return first, second, starts
 
 
 def still_settling(samples: np.ndarray, period: int, tolerance: float) -> bool:
@@ -189,10 +218,17 @@ def still_settling(samples: np.ndarray, period: int, tolerance: float) -> bool:
 
 def _probe_points(scenario: Scenario) -> np.ndarray:
     """Contactors, output points and five stations along the beam."""
-    L = scenario.beam.length
-    pts = [c.position for c in scenario.contactors] + list(scenario.output_points)
-    pts += list(np.linspace(0.2, 1.0, 5) * L)
-    return np.unique(np.asarray(pts, dtype=float))
+    return _probes(scenario.beam.length, tuple(c.position for c in scenario.contactors),
+                   tuple(scenario.output_points))
+
+
+@functools.lru_cache(maxsize=64)
+def _probes(length: float, contactors: tuple[float, ...], outputs: tuple[float, ...]) -> np.ndarray:
+    """:func:`_probe_points` of these positions (read only: a bifurcation diagram asks for them at every run)."""
+    pts = list(contactors) + list(outputs) + list(np.linspace(0.2, 1.0, 5) * length)
+    out = np.unique(np.asarray(pts, dtype=float))
+    out.flags.writeable = False
+    return out
 
 
 def _scaled(w: np.ndarray, v: np.ndarray) -> np.ndarray:
