@@ -69,14 +69,12 @@ class SlotArrays:
     residual: float = 0.0
 
 
-def _clustered(rates: np.ndarray) -> int:
-    """How many of ``rates`` lie within 1 % of another one."""
-    r = np.sort(np.asarray(rates, dtype=float))
-    close = np.abs(np.diff(r)) <= 0.01 * np.maximum(np.abs(r[1:]), 1e-300)
-    near = np.zeros(r.size, dtype=bool)
-    near[1:] |= close
-    near[:-1] |= close
-    return int(np.count_nonzero(near))
+def _clustered(values: np.ndarray) -> int:
+    """How many of ``values`` (complex) lie within 1 % of another one (in magnitude)."""
+    v = np.asarray(values, dtype=complex)
+    d = np.abs(v[:, None] - v[None, :])
+    np.fill_diagonal(d, np.inf)
+    return int(np.count_nonzero(np.any(d <= 0.01 * np.abs(v)[:, None], axis=1)))
 
 
 def _regimes(om: np.ndarray, dec: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -277,12 +275,11 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
     reg, wdh = _regimes(om, dec)
     Hm = np.linalg.inv(Gm)
     if np.linalg.norm(Hm @ Gm - np.eye(2 * n), np.inf) > 1e-6:
-        slow = dec[(reg == 2)] - wdh[(reg == 2)]  # the slower rate of each over-damped coordinate
         raise SimulationError(
             "non-proportional damping: the state's coordinates are too ill-conditioned to integrate exactly "
-            f"({_clustered(slow)} over-damped coordinates decay at rates within 1 % of another's: stiffness-"
-            "proportional damping of high modes, e.g. Rayleigh beta, puts them all near 1/beta); lower that "
-            'damping or the mode count, or run method = "ivp"'
+            f"({_clustered(np.linalg.eigvals(As))} of its {2 * n} eigenvalues lie within 1 % of another; "
+            "stiffness-proportional damping of high modes, e.g. Rayleigh beta, puts their slow decay rates all "
+            'near 1/beta); lower that damping or the mode count, or run method = "ivp"'
         )
     G = np.stack([Gm[:, :n], Gm[:, n:]])
     H = np.stack([Hm[:n], Hm[n:]])
