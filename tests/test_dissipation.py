@@ -325,5 +325,6 @@ def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
         "excitation": {"kind": "point_force", "shape": "step", "amplitude": -0.2, "position": 0.01704},
         "solver": {"modes": 4, "time_step": 1e-5, "end_time": 0.02},
     })
-    with pytest.raises(ib.SimulationError, match=r'the state with contactors 1 engaged: .* eigenvalues lie within 1 % .*1/beta.*method = "ivp"'):
+    why = r'the state with contactors 1 engaged: .* eigenvalues lie within 1 % .*1/beta.*method = "ivp"'
+    with pytest.raises(ib.SimulationError, match=why):
         ib.simulate(sc)
