@@ -97,7 +97,8 @@ def test_a_case_gives_the_same_bits_alone_or_in_a_batch():
                                  excitation=dataclasses.replace(sc.excitation, amplitude=a))
              for g, a in ((1e-4, 100.0), (4e-4, 180.0), (0.0, 60.0))]
     batch = [cases[n] for n in names] + extra + [cases[n] for n in names]
-    res = run_cases(batch)
+    with pytest.warns(ib.ImpactBeamWarning, match="chattering contact.* results cover 0 to"):  # as alone
+        res = run_cases(batch)
     assert all(e is None for e in res.errors), res.messages
     for k, c in enumerate(batch):
         alone = _alone(c)

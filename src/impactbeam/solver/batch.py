@@ -26,7 +26,7 @@ from ..model.beam import Beam, Contactor
 from ..model.loading import Excitation
 from ..model.starting import InitialCondition, Preload
 from . import _codes as _loop, kernels
-from .engine import _BUDGET, _pieces, _Records, _solution, pack, projection_warning, stop_message
+from .engine import _BUDGET, _pieces, _Records, _solution, pack, run_warnings, stop_message
 from .initial import initial_coordinates
 from .solution import Solution
 
@@ -230,11 +230,12 @@ def integrate_batch(
             warnings.append([])
             continue
         messages.append(stop_message(int(status[k]), float(t_stop[k]), int(out[k, 8])))
-        w = []
+        moved = None
         if warn[k, 0]:
-            w.append(projection_warning(int(warn[k, 0]), int(warn[k, 5]), options[k].modes, int(warn[k, 1]),
-                                        float(warn[k, 3]), float(warn[k, 4]), float(warn[k, 2])))
-        warnings.append(w)
+            moved = (int(warn[k, 0]), int(warn[k, 5]), options[k].modes, int(warn[k, 1]), float(warn[k, 3]),
+                     float(warn[k, 4]), float(warn[k, 2]))
+        warnings.append(run_warnings(int(status[k]), float(t_stop[k]), int(out[k, 8]), float(options[k].end_time),
+                                     moved))
     return BatchResult(out, status, t_stop, messages, warnings, errors)
 
 

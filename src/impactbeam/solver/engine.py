@@ -415,11 +415,11 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take: bool
     t_stop = float(fc[_loop.F_T])
     code = 1 if status == _loop.CHATTER else 0
     message = stop_message(code, t_stop, nev)
-    warnings: list[str] = []
+    moved = None
     if ic[_loop.I_WARN_N]:
-        warnings.append(projection_warning(int(ic[_loop.I_WARN_N]), njump, options.modes, int(ic[_loop.I_WARN_C]),
-                                           float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE]),
-                                           float(fc[_loop.F_WARN_T])))
+        moved = (int(ic[_loop.I_WARN_N]), njump, options.modes, int(ic[_loop.I_WARN_C]),
+                 float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE]), float(fc[_loop.F_WARN_T]))
+    warnings = run_warnings(code, t_stop, nev, float(options.end_time), moved)
     rec.taken = take and nseg > _TAKE and 2 * nseg > rec.seg_t0.size  # large and mostly used: no copy
 
     def out(a: np.ndarray) -> np.ndarray:
@@ -445,6 +445,17 @@ def stop_message(status: int, t_stop: float, n_events: int) -> str:
             "instant): chattering contact; the solution ends there."
         )
     return "The simulation reached end_time."
+
+
+def run_warnings(status: int, t_stop: float, n_events: int, end_time: float,
+                 moved: tuple | None = None) -> list[str]:
+    """The warnings of a run: the projection's (``moved``: the arguments of :func:`projection_warning`), and
+    a stop by the chattering guard (``status`` 1), whose results cover only ``[0, t_stop]``."""
+    out = [] if moved is None else [projection_warning(*moved)]
+    if status == 1:
+        out.append(f"{stop_message(status, t_stop, n_events)} The results cover 0 to {t_stop:.6g} s of the "
+                   f"{end_time:.6g} s asked: metrics are of that part, later samples are NaN.")
+    return out
 
 
 def projection_warning(count: int, switches: int, modes: int, contactor: int, moved: float, scale: float,

@@ -28,7 +28,9 @@ A contactor the projection of eq. (12) leaves on the wrong side of its new
 state (its row below ``-1e-12 L``) is judged at the restart by the engine's
 rule: it switches at once unless it is the contactor just switched and is
 moving back towards its side; then it switches where its row turns back
-(a terminal event on the row's slope), unless the row reaches 0 first.
+(a terminal event on the row's slope), unless the row reaches 0 first. A
+row touching 0 at a restart (two zero-gap stops crossed at one instant)
+switches at once when its slope points to the wrong side.
 
 Limitations (those of :func:`scipy.integrate.solve_ivp`): events are found
 from sign changes between accepted steps, so a graze that dips below the
@@ -51,7 +53,7 @@ from ..model.beam import Beam, Contactor
 from ..exceptions import SimulationError
 from ..model.loading import Excitation
 from ..model.starting import InitialCondition, Preload
-from .engine import make_space
+from .engine import make_space, run_warnings
 from .initial import initial_coordinates
 from .solution import Event, PiecewiseSolution, Samples
 from ..model import Damping, SolverOptions
@@ -248,14 +250,21 @@ class _Reference:
         ``-1e-12 L`` switches at once, unless it belongs to the contactor just
         switched (``just``) and is moving back towards its side, or this rule
         already switched its contactor twice at this instant (``judged``); those
-        switch where their slope turns negative while they are still at or below 0.
+        switch where their slope turns negative while they are still at or below 0. A row within
+        ``1e-12 L`` of 0 (touching) switches at once when its slope points to the wrong side.
         """
         tol = 1e-12 * self.beam.length
         wrong, turns = [], []
         for r, ev in enumerate(evs):
-            if ev(t, y0) >= -tol:
+            h = ev(t, y0)
+            if h > tol:
                 continue
-            back = rows[r][0] == just and rows[r][1] == "main" and self._slope_event(ev, rhs)(t, y0) >= 0.0
+            slope = self._slope_event(ev, rhs)(t, y0)
+            if h >= -tol:  # touching (a zero gap at a crossing, a contactor just switched): its slope decides
+                if slope < 0.0 and judged.get(rows[r][0], 0) < 2:
+                    wrong.append(r)
+                continue
+            back = rows[r][0] == just and rows[r][1] == "main" and slope >= 0.0
             if not back and judged.get(rows[r][0], 0) < 2:
                 wrong.append(r)
             else:
@@ -441,7 +450,7 @@ class IvpSolution(PiecewiseSolution):
         self.event_penetrations = penetrations
         self.status = status
         self.message = message
-        self.warnings = ()
+        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time)))
         self.t_end = t_end
         self.contactors = ref.contactors
         self.dashpots = ref.dash
