@@ -274,3 +274,25 @@ def test_a_projection_leaving_a_contactor_on_the_wrong_side(left, modes, k, gap,
     t = np.linspace(0.0, 0.02, 2001)
     w_ex, w_iv = ex.displacement([L], t), iv.displacement([L], t)
     assert np.max(np.abs(w_ex - w_iv)) <= 1e-8 * np.max(np.abs(w_iv))  # measured 2e-11 .. 2e-10
+
+
+def test_two_zero_gap_stops_crossed_at_one_instant():
+    # A two-sided clamp with no clearance: as w passes 0 one stop releases and the other engages at the same
+    # instant; after the switch the other row touches 0 and its slope points to the wrong side, so it switches
+    # at once (the engine judges it by the sign of its first derivative). The solve_ivp path used to start such
+    # a row a round-off below 0 and never see it cross.
+    L = 0.1092
+    sc = ib.parse_scenario({
+        "beam": {"length": L, "width": 9.93e-3, "height": 3.03e-3, "youngs_modulus": 1834e6, "density": 951.98},
+        "supports": {"left": "clamped", "right": "free"},
+        "contactors": [{"position_ratio": 0.809, "stiffness": 6.7e4, "gap": 0.0, "side": "above"},
+                       {"position_ratio": 0.809, "stiffness": 6.7e4, "gap": 0.0, "side": "below"}],
+        "damping": {"free": 0.0, "contact": 0.0},
+        "excitation": {"kind": "base_acceleration", "shape": "harmonic", "amplitude": -147.15, "frequency": 90.0},
+        "solver": {"modes": 10, "time_step": 1e-5, "end_time": 0.02},
+    })
+    args = problem(beam=sc.beam, contactors=sc.contactors, damping=sc.damping, excitation=sc.excitation,
+                   initial=sc.initial, options=sc.solver, points=[sc.contactors[0].position, L])
+    ex, _ = compare(args)
+    pairs = [(a.time, a.contactor, b.contactor) for a, b in zip(ex.events, ex.events[1:]) if a.time == b.time]
+    assert len(pairs) == 3 and all({c0, c1} == {0, 1} for _, c0, c1 in pairs)
