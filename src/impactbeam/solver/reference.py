@@ -178,6 +178,7 @@ class _Reference:
         self.gap = np.array([c.gap for c in contactors], dtype=float)
         self.side = np.array([c.direction for c in contactors], dtype=float)
         self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
+        self.tol = 1e-12 * beam.length  # the touch tolerance of the engine (tol_h)
         T = options.end_time
         all_eng = tuple(range(len(contactors)))
         states = [self.space.state(())] + ([self.space.state(all_eng)] if contactors else [])
@@ -253,7 +254,7 @@ class _Reference:
         switch where their slope turns negative while they are still at or below 0. A row within
         ``1e-12 L`` of 0 (touching) switches at once when its slope points to the wrong side.
         """
-        tol = 1e-12 * self.beam.length
+        tol = self.tol
         wrong, turns = [], []
         for r, ev in enumerate(evs):
             h = ev(t, y0)
@@ -270,6 +271,17 @@ class _Reference:
             else:
                 turns.append(r)
         return wrong, turns
+
+    def _shifted(self, ev):
+        """The terminal event ``ev`` moved by the touch tolerance: it fires where the row passes ``-tol``."""
+        tol = self.tol
+
+        def deeper(tt, y):
+            return ev(tt, y) + tol
+
+        deeper.terminal = True
+        deeper.direction = -1.0
+        return deeper
 
     @staticmethod
     def _slope_event(ev, rhs):
@@ -365,6 +377,9 @@ class _Reference:
             if wrong and rows[wrong[0]][1] == "phase":
                 phase[rows[wrong[0]][0]] = False  # the penetration left by a release is gone: a plain opening
                 continue
+            for r, ev in enumerate(evs):  # a row let run a round-off below 0 counts once deeper than the tolerance
+                if r not in wrong and -self.tol <= ev(t, y0) < 0.0:
+                    evs[r] = self._shifted(ev)
             turned: dict[int, int] = {}  # event index -> the row on the wrong side it watches turn back
             for r in turns:
                 turned[len(evs)] = r
@@ -414,7 +429,7 @@ class _Reference:
                     events.append(Event(t, kind, c, float(st.W_contact[c] @ deta)))
                     pens.append(self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c])
                 pen = self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c]
-                phase[c] = kind == "rebound" and self.dash[c] > 0.0 and pen > 1e-12 * self.beam.length
+                phase[c] = kind == "rebound" and self.dash[c] > 0.0 and pen > self.tol
                 P = self.space.transfer(new, engaged, self.opt.projection == "contact")
                 eta, deta = P @ eta, P @ deta
                 engaged = new
