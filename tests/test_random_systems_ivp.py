@@ -79,7 +79,8 @@ def random_system(seed: int) -> dict:
         d["damping"] = {"free": rng.choice([0.0, 0.005, 0.02, 0.3, 1.0]),
                         "contact": rng.choice([0.0, 0.01, 0.05, 0.8, 2.0])}
     elif u < 0.8:
-        d["damping"] = {"model": "rayleigh", "alpha": rng.choice([0.0, 5.0, 50.0]), "beta": rng.choice([0.0, 1e-5, 1e-4])}
+        d["damping"] = {"model": "rayleigh", "alpha": rng.choice([0.0, 5.0, 50.0]),
+                        "beta": rng.choice([0.0, 1e-5, 1e-4])}
     else:
         d["damping"] = {"model": "free_modes", "free": rng.choice([0.0, 0.01, 0.05])}
     kind = rng.choice(["base_acceleration", "point_force"])
