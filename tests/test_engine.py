@@ -271,6 +271,7 @@ def test_a_projection_leaving_a_contactor_on_the_wrong_side(left, modes, k, gap,
                    initial=sc.initial, options=sc.solver, points=[sc.contactors[0].position, L])
     ex, iv = compare(args)
     assert len(ex.events) >= 4
+    assert iv.warnings == ex.warnings  # the projection's warning by the same rule, word for word
     t = np.linspace(0.0, 0.02, 2001)
     w_ex, w_iv = ex.displacement([L], t), iv.displacement([L], t)
     assert np.max(np.abs(w_ex - w_iv)) <= 1e-8 * np.max(np.abs(w_iv))  # measured 2e-11 .. 2e-10

@@ -12,7 +12,8 @@ from __future__ import annotations
 __all__ = ["DONE", "CHATTER", "NEED_STATE", "NEED_TRANSFER", "NEED_SPACE", "CHECKPOINT", "CASE_DONE",
            "I_SLOT", "I_PIECE", "I_JUST", "I_PENDING", "I_NSEG", "I_NEV", "I_NJUMP", "I_NSLOTS", "I_NTR",
            "I_WARN_C", "REQ_A", "REQ_B", "I_RESUME", "I_EVALS", "I_SAME", "I_WARN_N", "I_USED", "N_INT",
-           "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "N_FLOAT"]
+           "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "N_FLOAT", "MOVED_WARN",
+           "MOVED_FLOOR"]
 
 DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
 CASE_DONE = 6  # a batch finished a case and stops after each (a continuation)
@@ -23,3 +24,8 @@ N_INT = 17
 # float carry
 F_T, F_LAST_T, F_WARN_T, F_WARN_MOVED, F_WARN_SCALE, F_TAU = 0, 1, 2, 3, 4, 5
 N_FLOAT = 6
+# a switch whose projection moves a contactor's deflection by more than MOVED_WARN of its scale (the larger of
+# its gap and deflection, at least MOVED_FLOOR touch tolerances: 1e-6 L, for a zero gap at rest) is counted
+# and warned about (engine.projection_warning), by the engine and the solve_ivp path alike
+MOVED_WARN = 0.05
+MOVED_FLOOR = 1e6

@@ -53,6 +53,7 @@ from ..model.beam import Beam, Contactor
 from ..exceptions import SimulationError
 from ..model.loading import Excitation
 from ..model.starting import InitialCondition, Preload
+from ._codes import MOVED_FLOOR, MOVED_WARN
 from .engine import make_space, run_warnings
 from .initial import initial_coordinates
 from .solution import Event, PiecewiseSolution, Samples
@@ -353,6 +354,7 @@ class _Reference:
         just: int | None = None  # the contactor switched at the current restart
         judged: dict[int, int] = {}  # switches made at once by _judge_start at the instant judged_t
         judged_t = -1.0
+        moved = _Moved(self.gap, self.tol)
         while t < T:
             while breaks[k_break] <= t:
                 k_break += 1
@@ -431,9 +433,11 @@ class _Reference:
                 pen = self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c]
                 phase[c] = kind == "rebound" and self.dash[c] > 0.0 and pen > self.tol
                 P = self.space.transfer(new, engaged, self.opt.projection == "contact")
+                w_before = st.W_contact @ eta
                 eta, deta = P @ eta, P @ deta
                 engaged = new
                 just = c
+                moved.record(t, w_before, self.space.state(new).W_contact @ eta)
                 jumps.append(self.energy(self.space.state(new), eta, deta) - E_before)
                 if len(events) >= self.opt.max_events or same_instant[c] > 4:
                     status = 1
@@ -445,8 +449,39 @@ class _Reference:
                     )
                     break
         return IvpSolution(self, segments, events, np.asarray(jumps, dtype=float), status, message,
-                           t if status else T, np.asarray(pens, dtype=float))
+                           t if status else T, np.asarray(pens, dtype=float), moved.worst(len(jumps), self.opt.modes))
 
+
+
+class _Moved:
+    """The switches whose projection moved a contactor's deflection by more than ``MOVED_WARN`` of its scale.
+
+    The engine's rule (:func:`~impactbeam.solver.engine.projection_warning`): the scale is the larger of the
+    contactor's gap and its deflection before the switch, at least ``MOVED_FLOOR`` touch tolerances.
+    """
+
+    def __init__(self, gap: np.ndarray, tol: float) -> None:
+        self.gap, self.tol = gap, tol
+        self.count = 0
+        self.top: tuple[float, int, float, float] | None = None  # t, contactor, moved, scale of the worst
+
+    def record(self, t: float, before: np.ndarray, after: np.ndarray) -> None:
+        lossy = False
+        for i in range(self.gap.size):
+            shift = abs(float(after[i] - before[i]))
+            scale = max(self.gap[i], abs(float(before[i])), MOVED_FLOOR * self.tol)
+            if shift > MOVED_WARN * scale:
+                if self.top is None or shift / scale > self.top[2] / self.top[3]:
+                    self.top = (t, i, shift, scale)
+                lossy = True
+        self.count += lossy
+
+    def worst(self, switches: int, modes: int) -> tuple | None:
+        """The arguments of :func:`~impactbeam.solver.engine.projection_warning`, or None."""
+        if self.top is None:
+            return None
+        t, i, shift, scale = self.top
+        return (self.count, switches, modes, i, shift, scale, t)
 
 
 class IvpSolution(PiecewiseSolution):
@@ -457,7 +492,8 @@ class IvpSolution(PiecewiseSolution):
     integrals by 8-point Gauss-Legendre on sub-intervals of a quarter period.
     """
 
-    def __init__(self, ref: _Reference, segments, events, jumps, status, message, t_end, penetrations) -> None:
+    def __init__(self, ref: _Reference, segments, events, jumps, status, message, t_end, penetrations,
+                 moved: tuple | None = None) -> None:
         self.ref = ref
         self.segments = segments
         self.events = events
@@ -465,7 +501,7 @@ class IvpSolution(PiecewiseSolution):
         self.event_penetrations = penetrations
         self.status = status
         self.message = message
-        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time)))
+        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time), moved))
         self.t_end = t_end
         self.contactors = ref.contactors
         self.dashpots = ref.dash
