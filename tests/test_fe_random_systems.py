@@ -43,6 +43,15 @@ _SUPPORTS = ["clamped", "pinned", "free", "sliding", {"translational": 1e3, "rot
 _L, _W, _H, _E, _RHO = 0.1092, 9.93e-3, 3.03e-3, 1834e6, 951.98
 
 
+def spaced_ratio(rng: random.Random, used: list[float]) -> float:
+    """A position ratio in [0.15, 1] at least 0.08 from those in ``used`` (appended there)."""
+    while True:
+        r = round(rng.uniform(0.15, 1.0), 3)
+        if all(abs(r - u) > 0.08 for u in used):
+            used.append(r)
+            return r
+
+
 def _random_system(seed: int) -> dict:
     """A scenario mapping drawn from ``seed`` (module docstring)."""
     rng = random.Random(seed)
@@ -53,11 +62,7 @@ def _random_system(seed: int) -> dict:
         right = "pinned"
     contactors, used = [], []
     for _ in range(rng.choice([1, 1, 1, 2, 3])):
-        while True:
-            r = round(rng.uniform(0.15, 1.0), 3)
-            if all(abs(r - u) > 0.08 for u in used):
-                break
-        used.append(r)
+        r = spaced_ratio(rng, used)
         c = {"position_ratio": r, "stiffness": k_ref * 10 ** rng.uniform(-0.5, 4.5),
              "gap": rng.choice([0.0, 1e-5, 1e-4, 3e-4, 1e-3]), "side": rng.choice(["above", "below"])}
         if rng.random() < 0.25:

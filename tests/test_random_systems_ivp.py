@@ -34,6 +34,7 @@ import pytest
 import impactbeam as ib
 
 from test_engine import compare, problem
+from test_fe_random_systems import spaced_ratio
 
 _L, _W, _H, _E, _RHO = 0.1092, 9.93e-3, 3.03e-3, 1834e6, 951.98
 _SUPPORTS = ["clamped", "pinned", "free", "sliding", {"translational": 1e3, "rotational": 0.0},
@@ -60,11 +61,7 @@ def random_system(seed: int) -> dict:
     contactors: list[dict] = []
     used: list[float] = []
     for _ in range(rng.choice([1, 1, 2, 3])):
-        while True:
-            r = round(rng.uniform(0.15, 1.0), 3)
-            if all(abs(r - u) > 0.08 for u in used):
-                break
-        used.append(r)
+        r = spaced_ratio(rng, used)
         c = {"position_ratio": r, "stiffness": k_ref * 10 ** rng.uniform(-0.5, 4.0),
              "gap": rng.choice([0.0, 1e-5, 1e-4, 3e-4]), "side": rng.choice(["above", "below"])}
         u = rng.random()
