@@ -449,8 +449,12 @@ def stop_message(status: int, t_stop: float, n_events: int) -> str:
 
 def run_warnings(status: int, t_stop: float, n_events: int, end_time: float,
                  moved: tuple | None = None) -> list[str]:
-    """The warnings of a run: the projection's (``moved``: the arguments of :func:`projection_warning`), and
-    a stop by the chattering guard (``status`` 1), whose results cover only ``[0, t_stop]``."""
+    """The warnings of a run, for the single run, the batch and the ``solve_ivp`` path alike.
+
+    The projection's (``moved``: the arguments of :func:`projection_warning`,
+    None when no switch moved a contactor's deflection that much), and a stop
+    by the chattering guard (``status`` 1), whose results cover only ``[0, t_stop]``.
+    """
     out = [] if moved is None else [projection_warning(*moved)]
     if status == 1:
         out.append(f"{stop_message(status, t_stop, n_events)} The results cover 0 to {t_stop:.6g} s of the "
@@ -460,10 +464,10 @@ def run_warnings(status: int, t_stop: float, n_events: int, end_time: float,
 
 def projection_warning(count: int, switches: int, modes: int, contactor: int, moved: float, scale: float,
                        when: float) -> str:
-    """The warning of switches whose projection moved a contactor's deflection by more than 5 %."""
+    """The warning of switches whose projection moved a contactor's deflection by more than ``MOVED_WARN``."""
     return (
-        f"{count} of {switches} switches: the projection onto {modes} modes moved the "
-        f"deflection at a contactor by more than 5 % of its gap or deflection (worst: contactor "
+        f"{count} of {switches} switches: the projection onto {modes} modes moved the deflection at a "
+        f"contactor by more than {100 * _loop.MOVED_WARN:g} % of its gap or deflection (worst: contactor "
         f"{contactor} by {moved:.3g} m, {100 * moved / scale:.0f} %, at t = "
         f"{when:.6g} s): the contactor is too stiff for this number of modes; add modes."
     )
