@@ -208,8 +208,10 @@ class _Reference:
         return evs, rows
 
     def _judge_start(self, evs: list, rows: list, t: float, y0: np.ndarray, rhs, just: int | None,
-                     judged: dict[int, int]) -> tuple[list[int], list[int]]:
-        """Rows on the wrong side at a restart: those to switch at once, and those to switch where they turn.
+                     judged: dict[int, int]) -> tuple[list[int], list[int], list[int]]:
+        """Rows on the wrong side at a restart: to switch at once, where they turn back, or let run from below 0.
+
+        The last are within the touch tolerance below 0; they count once deeper than it (:meth:`_shifted`).
 
         The engine's rule (:mod:`~impactbeam.solver._loop`): a row below
         ``-1e-12 L`` switches at once, unless it belongs to the contactor just
@@ -219,22 +221,24 @@ class _Reference:
         ``1e-12 L`` of 0 (touching) switches at once when its slope points to the wrong side.
         """
         tol = self.tol
-        wrong, turns = [], []
+        wrong, turns, below = [], [], []
         for r, ev in enumerate(evs):
             h = ev(t, y0)
             if h > tol:
                 continue
-            slope = self._slope_event(ev, rhs)(t, y0)
+            slope = self._slope(ev, rhs, t, y0)
             if h >= -tol:  # touching (a zero gap at a crossing, a contactor just switched): its slope decides
                 if slope < 0.0 and judged.get(rows[r][0], 0) < 2:
                     wrong.append(r)
+                elif h < 0.0:
+                    below.append(r)
                 continue
             back = rows[r][0] == just and rows[r][1] == "main" and slope >= 0.0
             if not back and judged.get(rows[r][0], 0) < 2:
                 wrong.append(r)
             else:
                 turns.append(r)
-        return wrong, turns
+        return wrong, turns, below
 
     def _shifted(self, ev):
         """The terminal event ``ev`` moved by the touch tolerance: it fires where the row passes ``-tol``."""
@@ -248,15 +252,16 @@ class _Reference:
         return deeper
 
     @staticmethod
-    def _slope_event(ev, rhs):
-        """Terminal event on the time derivative of the (affine) row ``ev`` along the flow, crossing down."""
-        y_ref = None
+    def _slope(ev, rhs, tt: float, y: np.ndarray) -> float:
+        """The time derivative of the affine row ``ev`` along the flow: its linear part applied to ``y'``."""
+        return ev(tt, rhs(tt, y)) - ev(tt, np.zeros_like(y))
+
+    @classmethod
+    def _slope_event(cls, ev, rhs):
+        """Terminal event on :meth:`_slope` of the row ``ev``, crossing down."""
 
         def slope(tt, y):
-            nonlocal y_ref
-            if y_ref is None or y_ref.shape != y.shape:
-                y_ref = np.zeros_like(y)
-            return ev(tt, rhs(tt, y)) - ev(tt, y_ref)  # the row is affine in y: its linear part on y'
+            return cls._slope(ev, rhs, tt, y)
 
         slope.terminal = True
         slope.direction = -1.0
@@ -338,13 +343,12 @@ class _Reference:
                 atol_state[engaged] = self.atol(st, y0)
             if t != judged_t:
                 judged, judged_t = {}, t
-            wrong, turns = self._judge_start(evs, rows, t, y0, rhs, just, judged)
+            wrong, turns, below = self._judge_start(evs, rows, t, y0, rhs, just, judged)
             if wrong and rows[wrong[0]][1] == "phase":
                 phase[rows[wrong[0]][0]] = False  # the penetration left by a release is gone: a plain opening
                 continue
-            for r, ev in enumerate(evs):  # a row let run a round-off below 0 counts once deeper than the tolerance
-                if r not in wrong and -self.tol <= ev(t, y0) < 0.0:
-                    evs[r] = self._shifted(ev)
+            for r in below:
+                evs[r] = self._shifted(evs[r])
             turned: dict[int, int] = {}  # event index -> the row on the wrong side it watches turn back
             for r in turns:
                 turned[len(evs)] = r
