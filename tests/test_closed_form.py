@@ -411,11 +411,9 @@ def _pair(fn):
     """``x -> (fn(x), 0.0)`` compiled, for :func:`_many`."""
     from numba import njit
 
-    inner = fn if hasattr(fn, "py_func") else njit(fn) if not isinstance(fn, type(math.exp)) else fn
-
     @njit
     def pair(x):
-        return inner(x), 0.0
+        return fn(x), 0.0
 
     return pair
 

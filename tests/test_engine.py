@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -38,8 +39,16 @@ CASES = sorted(EXAMPLES.glob("case[0-9][0-9].toml"))
 G = 9.80665
 T_EVENT = 1e-9
 R_METRIC = 1e-7
+_NUMBER = r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
 SCALARS = ("max_response", "t_max", "first_impact_time", "free_duration", "contact_duration", "min_response",
            "max_penetration")
+
+
+def _last_digit(token: str) -> float:
+    """The value of one unit in the last digit of a printed number (``"2.03e-05"`` -> 1e-7)."""
+    mantissa, _, exponent = token.lower().partition("e")
+    decimals = len(mantissa.partition(".")[2])
+    return 10.0 ** (int(exponent or 0) - decimals)
 
 
 def problem(path: Path = EXAMPLES / "case03.toml", **changes) -> dict:
@@ -271,7 +280,14 @@ def test_a_projection_leaving_a_contactor_on_the_wrong_side(left, modes, k, gap,
                    initial=sc.initial, options=sc.solver, points=[sc.contactors[0].position, L])
     ex, iv = compare(args)
     assert len(ex.events) >= 4
-    assert iv.warnings == ex.warnings  # the projection's warning by the same rule, word for word
+    # the projection's warning by the same rule: the same words, and the same numbers to within one unit of the
+    # last digit printed (the two paths' switch times and deflections differ by ~1e-12 relative, which can round
+    # a last digit apart on another machine)
+    assert [re.sub(_NUMBER, "#", w) for w in iv.warnings] == [re.sub(_NUMBER, "#", w) for w in ex.warnings]
+    for wi, we in zip(iv.warnings, ex.warnings):
+        assert wi.partition("(worst")[0] == we.partition("(worst")[0]  # the counts of switches and modes, exactly
+        for a, b in zip(re.findall(_NUMBER, wi.partition("(worst")[2]), re.findall(_NUMBER, we.partition("(worst")[2])):
+            assert abs(float(a) - float(b)) <= 1.0001 * _last_digit(b), (a, b)
     t = np.linspace(0.0, 0.02, 2001)
     w_ex, w_iv = ex.displacement([L], t), iv.displacement([L], t)
     assert np.max(np.abs(w_ex - w_iv)) <= 1e-8 * np.max(np.abs(w_iv))  # measured 2e-11 .. 2e-10
@@ -323,5 +339,8 @@ def test_a_dashpot_release_that_chatters_stops_both_paths():
     ex, iv = runs
     assert ex.status == iv.status == 1 and len(ex.events) == len(iv.events) == 400
     # the release that starts it: DOP853's event location, ~1e-10 s here (3.4e-10 measured)
-    assert abs(ex.events[1].time - iv.events[1].time) < 1e-8
-    assert abs(ex.solution.t_end - iv.solution.t_end) < 1e-6  # both stop within a microsecond of it
+    release = ex.events[1].time
+    assert abs(release - iv.events[1].time) < 1e-8
+    # the chatter is at the release: both paths spend their 400 events within a microsecond after it
+    # (measured 0.32 us for the engine, 0.16 us for solve_ivp)
+    assert release < ex.solution.t_end < release + 1e-6 and release < iv.solution.t_end < release + 1e-6
