@@ -27,7 +27,8 @@ import numpy as np
 
 from .._warnings import emit_user_level_warning
 from ..exceptions import ParameterError, ScenarioError
-from .strobe import PERIOD_TOLERANCE, SteadyState, count, harmonic_period, settle_and_record
+from .forcing import harmonic_period
+from .strobe import PERIOD_TOLERANCE, SteadyState, count, settle_and_record
 
 if TYPE_CHECKING:
     from ..scenario import Scenario

@@ -16,7 +16,6 @@ truncated model as the simulation.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -24,85 +23,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..exceptions import ParameterError
 from .bifurcation import BifurcationDiagram, bifurcation
-from .strobe import PERIOD_TOLERANCE, harmonic_period, strobe_point
+from .forcing import strobe_point
+from .linear import linear_frf, linear_steady_state
+from .strobe import PERIOD_TOLERANCE
 
 if TYPE_CHECKING:
     from ..scenario import Scenario
-    from ..solver.solution import ModalState
 
 __all__ = ["FrequencyResponse", "frequency_response", "from_diagram", "linear_frf", "linear_steady_state"]
-
-
-def _free_state(scenario: Scenario) -> tuple[Any, Any]:
-    """The packed problem of the solver and its free state (slot 0)."""
-    from ..solver.engine import pack
-
-    opt = scenario.solver
-    if opt.modes == "auto":
-        opt = dataclasses.replace(opt, modes=8)
-    pk = pack(scenario.beam, tuple(scenario.contactors), scenario.damping, scenario.excitation, opt)
-    return pk, opt
-
-
-def linear_frf(scenario: Scenario, frequencies: Sequence[float] | np.ndarray,
-               points: Sequence[float] | None = None) -> np.ndarray:
-    """Complex amplitude of ``w`` per unit load amplitude, without contact (module docstring).
-
-    Parameters
-    ----------
-    scenario : Scenario
-        Its beam, damping, load distribution (``excitation.kind``) and modes;
-        contactors are kept open.
-    frequencies : array_like, [Hz]
-    points : sequence of float, optional, [m]
-        Default: the strobe point (first contactor, else first output point).
-
-    Returns
-    -------
-    ndarray, complex, (n_frequencies, n_points)
-        ``H`` in m per unit of ``excitation.amplitude`` (times ``excitation.scale``).
-
-    Raises
-    ------
-    ParameterError
-        A point off the beam, or a negative or non-finite frequency.
-    """
-    pk, _ = _free_state(scenario)
-    x = np.asarray([strobe_point(scenario)] if points is None else points, dtype=float)
-    L = scenario.beam.length
-    bad = ~np.isfinite(x) | (x < 0.0) | (x > L * (1.0 + 1e-12))
-    if x.ndim != 1 or bad.any():
-        shown = x[bad][0] if x.ndim == 1 else x
-        raise ParameterError(f"points: {shown} m is not a position on the beam [0, {L:g}] m (a 1-D list)")
-    f = np.asarray(frequencies, dtype=float)
-    if f.ndim > 1 or not np.all(np.isfinite(f)) or np.any(f < 0.0):
-        raise ParameterError("frequencies: expected finite frequencies >= 0 [Hz] in a 1-D list")
-    W = pk.rows(x)[0]  # (n_x, n_modes), free state
-    om, dec, pw = pk.om[0], pk.dec[0], pk.pw[0]
-    Om = 2.0 * np.pi * np.atleast_1d(f)[:, None]
-    modal = pw[None, :] / (om[None, :] ** 2 - Om**2 + 2j * dec[None, :] * Om)
-    return modal @ W.T
-
-
-def linear_steady_state(scenario: Scenario) -> ModalState:
-    """The periodic state of the free (no contact) beam when its harmonic load has phase ``phase``.
-
-    A run from this state (``simulate(..., start=)``, load on from t = 0)
-    stays on the linear steady state as long as no contactor is touched:
-    a start with no transient for frequency-response curves and tests.
-    """
-    from ..solver.solution import ModalState, basis_signature
-
-    harmonic_period(scenario)
-    ex = scenario.excitation
-    pk, opt = _free_state(scenario)
-    om, dec, pw = pk.om[0], pk.dec[0], pk.pw[0]
-    Om = 2.0 * np.pi * float(ex.frequency)  # type: ignore[arg-type]
-    q = pw * (ex.scale * ex.amplitude) / (om**2 - Om**2 + 2j * dec * Om) * np.exp(1j * ex.phase)
-    basis = basis_signature(scenario.beam, scenario.contactors, int(opt.modes), opt.basis, ex)
-    return ModalState(0.0, np.ascontiguousarray(q.imag), np.ascontiguousarray((1j * Om * q).imag), basis)
 
 
 @dataclass(frozen=True, eq=False)

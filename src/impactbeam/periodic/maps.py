@@ -27,7 +27,8 @@ import numpy as np
 from .._optional import require
 from ..exceptions import ParameterError
 from .bifurcation import _dimension, _unit, _with, bifurcation, parameter_values
-from .strobe import PERIOD_TOLERANCE, count, harmonic_period
+from .forcing import harmonic_period
+from .strobe import PERIOD_TOLERANCE, count
 
 if TYPE_CHECKING:
     from ..scenario import Scenario

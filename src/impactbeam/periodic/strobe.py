@@ -27,7 +27,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._warnings import emit_user_level_warning
-from ..exceptions import ScenarioError
+from .forcing import harmonic_period, strobe_point
+from .linear import linear_limit
 
 if TYPE_CHECKING:
     from ..result import SimulationResult
@@ -113,25 +114,6 @@ def count(name: str, value: Any, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or int(value) < minimum:
         raise ParameterError(f"{name}: expected a whole number >= {minimum}, got {value!r}")
     return int(value)
-
-
-def harmonic_period(scenario: Scenario) -> float:
-    """The forcing period ``1/f`` [s]; ScenarioError unless the load is harmonic."""
-    ex = scenario.excitation
-    if ex.kind == "none" or ex.shape != "harmonic" or ex.frequency is None:
-        raise ScenarioError(
-            'excitation.shape: steady-state analysis needs a harmonic load (shape = "harmonic" with a '
-            f"frequency), got kind = {ex.kind!r}, shape = {ex.shape!r}",
-            key="excitation.shape",
-        )
-    return 1.0 / float(ex.frequency)
-
-
-def strobe_point(scenario: Scenario) -> float:
-    """Where the strobe samples ``w``: the first contactor, else the first output point [m]."""
-    if scenario.contactors:
-        return float(scenario.contactors[0].position)
-    return float(scenario.output_points[0])
 
 
 def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
@@ -440,7 +422,16 @@ def steady_state(
 
 def settle_and_record(scenario: Scenario, settle: int, record: int, start_state: ModalState | None,
                       tolerance: float, max_period: int | None, limit: int) -> SteadyState:
-    """Run, analyse, and extend the run while no period is found (see :func:`steady_state`)."""
+    """Run, analyse, and extend the run while no period is found (see :func:`steady_state`).
+
+    When the beam provably never touches a stop from its start, the record is
+    run from the linear steady state it tends to (:func:`~impactbeam.periodic.
+    linear.linear_limit`): exact, with ``settled_after = 0``.
+    """
+    steady = linear_limit(scenario, start_state)
+    if steady is not None:
+        res, t_load = run_periods(scenario, record, start_state=steady)
+        return _record_analysis(res, scenario, 0, record, tolerance, max_period, t_load, 0).steady_state()
     res, t_load = run_periods(scenario, settle + record, start_state=start_state)
     done = settle
     while True:

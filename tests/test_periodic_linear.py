@@ -1,0 +1,111 @@
+"""The linear limit of a harmonically forced run: the bound that says the beam never reaches a stop.
+
+:func:`linear_limit` claims that from a start state the deflection at every
+contactor stays below ``|H| A + sum_n |W_n| R_n`` (the linear steady state
+plus each mode's transient envelope) and so never reaches a gap it is short
+of. Checked here against the time integration it replaces: from random
+starts the engine must never record an event where the bound said clear
+(soundness), the bound must not be vacuous, and where it is clear the
+steady state it records must be the one a long run converges to.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import impactbeam as ib
+from impactbeam.periodic.linear import linear_frf, linear_limit, linear_steady_state
+from impactbeam.periodic.strobe import steady_state
+from impactbeam.scenario import parse_scenario
+from impactbeam.solver.solution import ModalState
+
+G = 9.80665
+SPECIMEN = {"length": 0.10920, "width": 9.93e-3, "height": 3.03e-3, "youngs_modulus": "1834 MPa",
+            "density": "951.98 kg/m^3"}
+
+
+def _scenario(frequency: float, contactors: list[dict], damping: float = 0.03, **solver):
+    return parse_scenario({
+        "beam": SPECIMEN,
+        "supports": {"left": "clamped", "right": "free"},
+        "contactors": contactors,
+        "damping": {"free": damping, "contact": 0.02},
+        "excitation": {"kind": "base_acceleration", "shape": "harmonic", "amplitude": "1 g",
+                       "frequency": frequency, "phase": 0.4},
+        "solver": {"modes": 6, **solver},
+    })
+
+
+def _f1() -> float:
+    return float(ib.modes(_scenario(50.0, [])).free.frequencies_hz[0])
+
+
+def _cases():
+    """A tip stop above, and two stops (above at mid-span, below at the tip), near the first resonance."""
+    f = 0.85 * _f1()
+    one = _scenario(f, [{"position_ratio": 1.0, "stiffness": 4e4, "gap": 1.0, "side": "above"}])
+    two = _scenario(f, [{"position_ratio": 0.5, "stiffness": 4e4, "gap": 1.0, "side": "above"},
+                        {"position_ratio": 1.0, "stiffness": 1e3, "gap": 1.0, "side": "below"}])
+    out = []
+    for sc in (one, two):
+        h = np.abs(linear_frf(sc, [sc.excitation.frequency], [c.position for c in sc.contactors])[0]) * G
+        out.append(sc.with_values({f"contactors.{i}.gap": float(1.6 * hi) for i, hi in enumerate(h)}))
+    return out
+
+
+@pytest.mark.parametrize("case", [0, 1])
+def test_bound_is_sound_and_not_vacuous(case):
+    """No random start the bound calls clear ever touches a stop; some starts are clear, some touch."""
+    sc = _cases()[case]
+    steady = linear_steady_state(sc)
+    rng = np.random.default_rng(7 + case)
+    n = steady.eta.size
+    run = sc.with_values({"solver.end_time": 0.4})  # ~4 time constants of the first mode at 3 % damping
+    clear = touched = 0
+    for size in np.geomspace(0.02, 20.0, 30):
+        # a transient of random direction, its size relative to the steady state (mode by mode in velocity too)
+        eta = steady.eta + size * np.abs(steady.eta).max() * rng.normal(size=n) / np.sqrt(np.arange(1, n + 1))
+        deta = steady.deta + size * np.abs(steady.deta).max() * rng.normal(size=n) / np.arange(1, n + 1)
+        start = ModalState(0.0, eta, deta, steady.basis)
+        said_clear = linear_limit(sc, start) is not None
+        events = ib.simulate(run, start=start).events
+        assert not (said_clear and events), f"size {size:.3g}: the bound said clear but the beam touched"
+        clear += said_clear
+        touched += bool(events)
+    # not vacuous: the small transients are clear, the large ones touch (measured 14 and 11 clear, 10 and 11
+    # touching of 30 in the two cases; the rest neither touch within 0.4 s nor are provably clear)
+    assert clear >= 5 and touched >= 5
+
+
+def test_clear_start_records_the_limit_a_long_run_reaches():
+    """Where the bound is clear the steady state is the linear limit at once, equal to a 300-period run's record."""
+    sc = _cases()[1]
+    steady = linear_steady_state(sc)
+    start = ModalState(0.0, steady.eta * 1.3, steady.deta * 0.8, steady.basis)
+    assert linear_limit(sc, start) is not None
+    quick = steady_state(sc, settle_periods=300, record_periods=10, start_state=start)
+    assert quick.settled_after == 0 and quick.period == 1 and quick.impacts_per_period == 0
+    T = 1.0 / sc.excitation.frequency
+    long = ib.simulate(sc.with_values({"solver.end_time": 310 * T}), start=start)
+    x0 = sc.contactors[0].position
+    tail = long.displacement([x0], 300 * T + T * np.arange(10))[0]
+    # tolerance: after 300 periods the transient has decayed by exp(-0.03 * omega_1 * 300 T) ~ 6e-14 of its
+    # start (plus round-off): 1e-10 of the amplitude
+    np.testing.assert_allclose(quick.strobe, tail, rtol=0, atol=1e-10 * abs(quick.max))
+
+
+@pytest.mark.parametrize("why", ["undamped", "preload", "auto modes", "linear response reaches the gap",
+                                 "initial velocity"])
+def test_no_limit_where_the_bound_does_not_apply(why):
+    sc = _cases()[0]
+    gap = sc.contactors[0].gap
+    change = {
+        "undamped": {"damping.free": 0.0},
+        "auto modes": {"solver.modes": "auto"},
+        "linear response reaches the gap": {"contactors.0.gap": gap / 2.0},
+        "initial velocity": {"initial.velocity": 0.01},
+        "preload": {"preload.kind": "base_acceleration", "preload.amplitude": 0.1},
+    }[why]
+    sc = sc.with_values(change)
+    assert linear_limit(sc, None) is None
