@@ -72,7 +72,10 @@ class SteadyState:
         The recorded interval (in the clock of the last run).
     settled_after : int
         Forcing periods run before the record (more than asked for when the
-        period test failed and the run was extended, see :func:`steady_state`).
+        period test failed and the run was extended, see :func:`steady_state`;
+        0 when the beam provably never reaches a stop from its start: the
+        record is then the exact linear steady state,
+        :func:`~impactbeam.periodic.linear.linear_limit`).
     result : SimulationResult
         The run (dense output over settle and record).
     warnings : list of str
@@ -386,7 +389,10 @@ def steady_state(
         With ``[excitation] shape = "harmonic"``; ``solver.end_time`` is
         replaced by ``start + (settle_periods + record_periods) / f``.
     settle_periods, record_periods : int
-        Forcing periods discarded as transient, then recorded.
+        Forcing periods discarded as transient, then recorded. No period is
+        discarded when the beam provably never reaches a stop from the start:
+        the record is then the linear steady state itself (``settled_after =
+        0``; :func:`~impactbeam.periodic.linear.linear_limit`).
     start_state : ModalState, optional
         Begin from this state (e.g. ``previous.result.final_state()``) with the
         load on from t = 0, instead of the scenario's initial condition.
