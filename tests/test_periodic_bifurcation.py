@@ -128,6 +128,31 @@ def test_from_rest_differs_from_continuation_only_by_the_start(scenario_file):
     np.testing.assert_array_equal(a.points[1].state.strobe, b.strobe)
 
 
+def test_auto_modes_chosen_once_and_carried(scenario_file):
+    """solver.modes = "auto": the first run chooses the count; extensions and continuation keep it.
+
+    Both need the modal state of a previous run, which only a fixed count has: an extended steady state
+    and a continued diagram used to stop with an error about a ``start`` the user never gave.
+    """
+    sc = ib.load_scenario(scenario_file).with_values({"solver.modes": "auto"})
+    # 5 settle + 4 recorded periods do not settle at 60 Hz: the run is extended from its final state
+    with pytest.warns(ib.ImpactBeamWarning, match="no period"):
+        ss = steady_state(sc, settle_periods=5, record_periods=4, max_settle_periods=20)
+    assert ss.settled_after == 14
+    chosen = ss.result.n_modes
+    with pytest.warns(ib.ImpactBeamWarning, match="no period"):
+        fixed = steady_state(sc.with_values({"solver.modes": chosen}), settle_periods=5, record_periods=4,
+                             max_settle_periods=20)
+    np.testing.assert_array_equal(ss.strobe, fixed.strobe)  # the same runs: the same bits
+    with pytest.warns(ib.ImpactBeamWarning) as record:
+        d = bifurcation(sc, "excitation.frequency", [59.0, 60.0], settle_periods=5, record_periods=4,
+                        max_settle_periods=5)
+    assert not any("modal basis" in str(w.message) for w in record)  # continued, not restarted from rest
+    assert [p.state.result.n_modes for p in d.points] == [chosen, chosen]
+    with pytest.raises(ParameterError, match="start_state"):
+        steady_state(sc, start_state=ss.result.final_state())
+
+
 def test_api_errors(scenario_file):
     sc = ib.load_scenario(scenario_file)
     with pytest.raises(ParameterError, match="sweep"):

@@ -28,7 +28,7 @@ import numpy as np
 from .._warnings import emit_user_level_warning
 from ..exceptions import ParameterError, ScenarioError
 from .forcing import harmonic_period
-from .strobe import PERIOD_TOLERANCE, SteadyState, count, settle_and_record
+from .strobe import PERIOD_TOLERANCE, SteadyState, count, settle_and_record, with_modes_of
 
 if TYPE_CHECKING:
     from ..scenario import Scenario
@@ -238,6 +238,10 @@ def bifurcation(
         A value whose period is not found is run on up to this many settling
         periods (default ``10 * settle_periods``;
         :func:`~impactbeam.periodic.strobe.steady_state`).
+
+    With ``solver.modes = "auto"`` the first value's run chooses the mode
+    count and every value is run with it (``point.state.result.n_modes``):
+    continuation carries the modal state from one value to the next.
     progress : callable, optional
         ``progress(done, total)`` after each value.
 
@@ -277,6 +281,8 @@ def bifurcation(
             start = None
         ss = settle_and_record(sc, settle, record, start, tolerance, None, limit)
         res = ss.result
+        if sc.solver.modes == "auto":  # the count chosen for the first value, kept: continuation carries the state
+            scenarios = {u: with_modes_of(s, res) for u, s in scenarios.items()}
         for w in ss.warnings:
             warns.append(f"{parameter} = {v:.6g} ({direction}): {w}")
         points.append(BifurcationPoint(v, direction, ss))

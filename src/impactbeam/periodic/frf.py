@@ -26,7 +26,7 @@ import numpy as np
 from .bifurcation import BifurcationDiagram, bifurcation
 from .forcing import strobe_point
 from .linear import linear_frf, linear_steady_state
-from .strobe import PERIOD_TOLERANCE
+from .strobe import PERIOD_TOLERANCE, with_modes_of
 
 if TYPE_CHECKING:
     from ..scenario import Scenario
@@ -129,6 +129,8 @@ def from_diagram(scenario: Scenario, d: BifurcationDiagram) -> FrequencyResponse
     if d.parameter != "excitation.frequency":
         raise ParameterError(f"a frequency-response curve needs --parameter excitation.frequency, got {d.parameter}")
     f = np.array([p.value for p in d.points])
+    if d.points:  # the diagram's own mode count (solver.modes = "auto" chose it on the first value)
+        scenario = with_modes_of(scenario, d.points[0].state.result)
     ex = scenario.excitation
     lin = np.abs(linear_frf(scenario, f)[:, 0]) * abs(ex.scale * ex.amplitude)
     return FrequencyResponse(

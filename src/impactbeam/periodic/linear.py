@@ -61,8 +61,8 @@ def linear_frf(scenario: Scenario, frequencies: Sequence[float] | np.ndarray,
     Parameters
     ----------
     scenario : Scenario
-        Its beam, damping, load distribution (``excitation.kind``) and modes;
-        contactors are kept open.
+        Its beam, damping, load distribution (``excitation.kind``) and modes
+        (``solver.modes = "auto"`` is read as 8); contactors are kept open.
     frequencies : array_like, [Hz]
     points : sequence of float, optional, [m]
         Default: the strobe point (first contactor, else first output point).

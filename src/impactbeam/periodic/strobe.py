@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._warnings import emit_user_level_warning
+from ..exceptions import ParameterError
 from .forcing import harmonic_period, strobe_point
 from .linear import linear_limit
 
@@ -112,8 +113,6 @@ class SteadyState:
 
 def count(name: str, value: Any, minimum: int) -> int:
     """An integer >= ``minimum``; ParameterError naming ``name`` otherwise."""
-    from ..exceptions import ParameterError
-
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or int(value) < minimum:
         raise ParameterError(f"{name}: expected a whole number >= {minimum}, got {value!r}")
     return int(value)
@@ -387,7 +386,9 @@ def steady_state(
     ----------
     scenario : Scenario
         With ``[excitation] shape = "harmonic"``; ``solver.end_time`` is
-        replaced by ``start + (settle_periods + record_periods) / f``.
+        replaced by ``start + (settle_periods + record_periods) / f``. With
+        ``solver.modes = "auto"`` the first run chooses the count, and a run
+        extended from its final state keeps it (``result.n_modes``).
     settle_periods, record_periods : int
         Forcing periods discarded as transient, then recorded. No period is
         discarded when the beam provably never reaches a stop from the start:
@@ -420,10 +421,24 @@ def steady_state(
     settle = count("settle_periods", settle_periods, 0)
     record = count("record_periods", record_periods, 2)
     limit = 10 * settle if max_settle_periods is None else count("max_settle_periods", max_settle_periods, 0)
+    if start_state is not None and scenario.solver.modes == "auto":
+        raise ParameterError('start_state: a start from a modal state needs a fixed solver.modes (the basis the '
+                             'state belongs to), got "auto"')
     ss = settle_and_record(scenario, settle, record, start_state, tolerance, max_period, limit)
     for text in ss.warnings:
         emit_user_level_warning(text)
     return ss
+
+
+def with_modes_of(scenario: Scenario, result: SimulationResult) -> Scenario:
+    """``scenario`` with ``solver.modes = "auto"`` replaced by the count ``result`` chose (else unchanged).
+
+    A run that goes on from another's modal state needs that state's basis,
+    so the count "auto" chose for the first run is kept for the rest.
+    """
+    if scenario.solver.modes != "auto":
+        return scenario
+    return dataclasses.replace(scenario, solver=dataclasses.replace(scenario.solver, modes=int(result.n_modes)))
 
 
 def settle_and_record(scenario: Scenario, settle: int, record: int, start_state: ModalState | None,
@@ -432,13 +447,16 @@ def settle_and_record(scenario: Scenario, settle: int, record: int, start_state:
 
     When the beam provably never touches a stop from its start, the record is
     run from the linear steady state it tends to (:func:`~impactbeam.periodic.
-    linear.linear_limit`): exact, with ``settled_after = 0``.
+    linear.linear_limit`): exact, with ``settled_after = 0``. With
+    ``solver.modes = "auto"`` the first run chooses the count; an extension
+    carries the modal state, so it runs with that count (:func:`with_modes_of`).
     """
     steady = linear_limit(scenario, start_state)
     if steady is not None:
         res, t_load = run_periods(scenario, record, start_state=steady)
         return _record_analysis(res, scenario, 0, record, tolerance, max_period, t_load, 0).steady_state()
     res, t_load = run_periods(scenario, settle + record, start_state=start_state)
+    scenario = with_modes_of(scenario, res)
     done = settle
     while True:
         rec = _record_analysis(res, scenario, settle, record, tolerance, max_period, t_load, done)
