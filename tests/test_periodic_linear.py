@@ -109,3 +109,13 @@ def test_no_limit_where_the_bound_does_not_apply(why):
     }[why]
     sc = sc.with_values(change)
     assert linear_limit(sc, None) is None
+
+
+def test_without_contactors_the_steady_state_is_the_linear_one_at_once():
+    """No stop to reach: from rest the record is the linear steady state, |H| A at the output point."""
+    sc = _scenario(0.85 * _f1(), [])
+    ss = steady_state(sc, settle_periods=100, record_periods=10)
+    amp = abs(linear_frf(sc, [sc.excitation.frequency])[0, 0]) * G
+    assert ss.settled_after == 0 and ss.period == 1
+    # tolerance: the same modes in time and frequency domain, round-off (4e-16 measured)
+    assert ss.max == pytest.approx(amp, rel=1e-12)

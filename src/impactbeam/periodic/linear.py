@@ -134,14 +134,15 @@ def linear_limit(scenario: Scenario, start: ModalState | None) -> ModalState | N
     -------
     ModalState or None
         :func:`linear_steady_state` when the bound of the module docstring
-        stays within :data:`CLEAR_FRACTION` of every gap; None when it does
+        stays within :data:`CLEAR_FRACTION` of every gap (without contactors:
+        always, the beam being linear); None when it does
         not, or when the bound does not apply: a preload, a mode that is not
         underdamped (or undamped, so no transient decays), a free state whose
         damping its modes do not diagonalise, ``solver.modes = "auto"``, a
         start in another basis or a non-rest initial condition.
     """
     opt = scenario.solver
-    if not scenario.contactors or opt.modes == "auto" or scenario.preload is not None:
+    if opt.modes == "auto" or scenario.preload is not None:
         return None
     if start is None and not scenario.initial.at_rest:
         return None
