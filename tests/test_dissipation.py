@@ -301,13 +301,6 @@ def test_bad_dissipation_input_names_the_key(make, match):
         make()
 
 
-def test_shooting_refuses_non_proportional_states():
-    sc = ib.load_scenario(EXAMPLES / "periodic" / "specimen_harmonic.toml")
-    sc = sc.with_values({"contactors.0.damping": 0.5})
-    with pytest.raises(ParameterError, match="dashpots"):
-        ib.periodic_orbit(sc)
-
-
 def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
     # Rayleigh beta = 1e-4 s on the enriched basis of a dashpot stop: the over-damped high coordinates all
     # decay near 1/beta, so the block coordinates of that state are nearly dependent and cannot carry the

@@ -10,7 +10,10 @@ mode
 
 with ``e_C, e_S`` the kernels of :mod:`impactbeam.solver._closed` (every
 damping regime) and ``a = xi omega``. The load only shifts the particular
-solution and drops out of the derivative.
+solution and drops out of the derivative. A state whose modes do not
+diagonalise its damping (dashpots, free-mode damping) is integrated by 2 x 2
+blocks (:mod:`impactbeam.solver.blocks`), each such an oscillator: its
+transition is ``G Phi H`` (:func:`slot_transition`).
 
 At a switch of contactor ``c`` at time ``t_e`` (its opening
 ``g(x) = base + v . eta`` crosses zero) the coordinates are carried into the
@@ -27,7 +30,10 @@ of the new state at the transferred point. A contactor spring engages with
 zero force, so in the shared Ritz basis ``f+ = T f-`` and ``S = T``; with the
 paper's per-state modes the lossy projection leaves a non-zero correction.
 ``grad g . f- ~ 0`` is a grazing contact, where the map is not smooth
-(its derivative grows like ``1 / (grad g . f-)``).
+(its derivative grows like ``1 / (grad g . f-)``). A dashpot contactor is
+released where its force ``k d + c d'`` vanishes, and engaged again by that
+force while still compressed: then ``g`` is the force and its gradient holds
+the velocity (:func:`_switching_gradient`).
 """
 
 from __future__ import annotations
@@ -37,14 +43,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..exceptions import ParameterError
-
-__all__ = ["FlowJacobian", "flow_jacobian", "segment_transition", "to_free", "from_free", "GRAZING"]
+__all__ = ["FlowJacobian", "flow_jacobian", "segment_transition", "slot_transition", "to_free", "from_free",
+           "GRAZING"]
 
 #: An event whose normal velocity is below this fraction of the orbit's velocity scale is grazing:
 #: near a grazing contact the map grows like the square root of the penetration (its derivative
 #: like 1/velocity), so a Jacobian there holds only in a tiny neighbourhood.
 GRAZING = 1e-4
+#: A dashpot contactor that engages with a compression above this fraction of the beam's length is in its
+#: released phase (engaged by its force, not its opening); at an ordinary impact the compression is round-off.
+_PHASE = 1e-9
 
 
 @dataclass
@@ -86,6 +94,23 @@ def segment_transition(reg: np.ndarray, dec: np.ndarray, wdh: np.ndarray, om: np
     out[n + idx, idx] = -om * om * eS
     out[n + idx, n + idx] = eC - dec * eS
     return out
+
+
+def slot_transition(pk, s: int, tau: float) -> np.ndarray:
+    """Homogeneous transition of state slot ``s`` over ``tau`` in its modal coordinates ``(eta, eta_t)``.
+
+    A state whose modes diagonalise its damping: :func:`segment_transition`.
+    Otherwise its coordinates are the 2 x 2 blocks of
+    :mod:`~impactbeam.solver.blocks`, each a damped oscillator in ``(z0, z1)``
+    (the load only shifts ``z1``): ``x = G z``, ``z = H x``, so the
+    transition is ``G Phi H`` with ``Phi`` the blocks' :func:`segment_transition`.
+    """
+    Phi = segment_transition(pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], tau)
+    if not pk.gen[s]:
+        return Phi
+    G = np.concatenate([pk.G[s, 0], pk.G[s, 1]], axis=1)
+    H = np.concatenate([pk.H[s, 0], pk.H[s, 1]], axis=0)
+    return G @ Phi @ H
 
 
 def _block(T: np.ndarray) -> np.ndarray:
@@ -141,10 +166,12 @@ class _Field:
         return F
 
     def __call__(self, s: int, kp: int, t: float, x: np.ndarray) -> np.ndarray:
+        """``(eta_t, eta_tt)`` in slot ``s``'s modal frame: its frequencies and damping matrix (dashpots in it)."""
         pk = self.pk
         n = pk.n_modes
         eta, deta = x[:n], x[n:]
-        acc = self.force(s, kp, t) - 2.0 * pk.dec[s] * deta - pk.om[s] ** 2 * eta
+        damp = pk.Cd[s] @ deta if pk.gen[s] else 2.0 * pk.dec[s] * deta
+        acc = self.force(s, kp, t) - damp - pk.omo[s] ** 2 * eta
         return np.concatenate([deta, acc])
 
     def end_state(self, j: int) -> np.ndarray:
@@ -163,9 +190,39 @@ class _Field:
                                 h0, dh0, P, lA, lB, lD, lE, AL)
         e = np.empty(pk.n_modes)
         d = np.empty(pk.n_modes)
-        state_at(float(sol.t1[j] - sol.t0[j]), pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], h0, dh0, P, Om, phi, e, d,
-                 kernel_work(pk.n_modes))
+        tau = float(sol.t1[j] - sol.t0[j])
+        state_at(tau, pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], h0, dh0, P, Om, phi, e, d, kernel_work(pk.n_modes))
+        if pk.gen[s]:  # block coordinates (z, z') into the modal frame, as the engine's samples
+            from ..solver._closed import alpha_at
+            from ..solver._loop import to_modal
+
+            alpha = np.empty(pk.n_modes)
+            alpha_at(AL, tau, Om, phi, alpha)
+            z, dz = e.copy(), d.copy()
+            to_modal(1, pk.G[s], z, dz, alpha, e, d)
         return np.concatenate([e, d])
+
+
+def _switching_gradient(fld: _Field, s: int, mask: int, c: int, x: np.ndarray) -> np.ndarray:
+    """Gradient (up to a factor) of the function whose zero switches contactor ``c`` out of slot ``s``.
+
+    The engine's rows (:func:`~impactbeam.solver._loop.contactor_rows`): the
+    opening or penetration ``d = s w(a) - gap``, whose gradient is
+    ``(W(a), 0)``; with a dashpot, a release where the force ``k d + c_d d'``
+    vanishes and a re-engagement while still compressed (``d > 0``, the
+    released phase), both ``(W(a), (c_d / k) W(a))``.
+    """
+    pk = fld.pk
+    n = pk.n_modes
+    W = pk.Wc[s, c]
+    r = 0.0
+    dash = float(pk.dash[c]) if pk.dash.size else 0.0
+    if dash > 0.0:
+        engaged = (mask >> c) & 1
+        compressed = fld.side[c] * float(W @ x[:n]) - fld.gap[c] > _PHASE * float(pk.space.beam.length)
+        if engaged or compressed:
+            r = dash / fld.kst[c]
+    return np.concatenate([W, r * W])
 
 
 def _switches(sol, j: int) -> list[int]:
@@ -189,9 +246,10 @@ def _velocity_scale(sol) -> float:
     """Largest velocity at a contactor at a segment start or an event [m/s] (the grazing yardstick)."""
     pk = sol.packed
     v = [abs(ev.velocity) for ev in sol.events]
-    if sol.n_segments and pk.Wc.shape[1]:
-        Wc = pk.Wc[sol.slot]  # (nseg, nc, n)
-        v.append(float(np.abs(np.einsum("jcn,jn->jc", Wc, sol.deta0)).max()))
+    modal = pk.gen[sol.slot] == 0  # segments recorded in modal coordinates (the others in block coordinates)
+    if modal.any() and pk.Wc.shape[1]:
+        Wc = pk.Wc[sol.slot[modal]]  # (nseg, nc, n)
+        v.append(float(np.abs(np.einsum("jcn,jn->jc", Wc, sol.deta0[modal])).max()))
     return max(v, default=0.0) or 1.0
 
 
@@ -210,12 +268,6 @@ def flow_jacobian(sol) -> FlowJacobian:
     FlowJacobian
     """
     pk = sol.packed
-    n = pk.n_modes
-    if pk.general or np.any(pk.dash > 0.0):
-        raise ParameterError(
-            "periodic orbits by shooting need states whose modes diagonalise their damping: contactor dashpots "
-            '(contactors.N.damping, restitution) and damping.model = "free_modes" are not supported there'
-        )
     fld = _Field(sol)
     nseg = sol.n_segments
     if nseg == 0:
@@ -226,7 +278,7 @@ def flow_jacobian(sol) -> FlowJacobian:
     grazing: list[tuple[float, float]] = []
     for j in range(nseg):
         s = int(sol.slot[j])
-        J = segment_transition(pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], float(sol.t1[j] - sol.t0[j])) @ J
+        J = slot_transition(pk, s, float(sol.t1[j] - sol.t0[j])) @ J
         if j + 1 == nseg:
             break
         cs = _switches(sol, j)
@@ -242,7 +294,7 @@ def flow_jacobian(sol) -> FlowJacobian:
             f_minus = fld(s, kp, te, x)
             xp = Tb @ x
             f_plus = fld(new, kp, te, xp)
-            grad = np.concatenate([pk.Wc[s, c], np.zeros(n)])
+            grad = _switching_gradient(fld, s, mask, c, x)
             normal = float(grad @ f_minus)
             if abs(normal) < GRAZING * velocity_scale:
                 grazing.append((te, abs(normal) / velocity_scale))

@@ -230,18 +230,30 @@ def _check(scenario: Scenario, multiple: Any) -> int:
 def _section_phase(sol: Any, lo: float, hi: float, start: float, f: float, prefer_free: bool) -> float:
     """Phase (fraction of the forcing period) of the middle of the longest event-free interval in ``[lo, hi]``.
 
-    With ``prefer_free`` only intervals of the free state count when there are any.
+    With ``prefer_free`` only intervals of the free state count when there are any. An interval where a
+    contactor with a dashpot is released but still compressed (its released phase) does not count as
+    free: the map's state (the modal coordinates) cannot tell that phase from an engaged contact.
     """
     times = [lo] + [ev.time for ev in sol.events if lo < ev.time < hi] + [hi]
     best, best_len, best_free = 0.5 * (lo + hi), -1.0, False
+    dashed = [i for i in range(len(sol.contactors)) if sol.dashpots[i] > 0.0]
     for a, b in zip(times[:-1], times[1:]):
         mid = 0.5 * (a + b)
         j = int(sol.segment_index(np.array([mid]))[0])
-        free = sol.engaged(j) == ()
+        free = sol.engaged(j) == () and not _compressed(sol, dashed, mid)
         key_better = (free and not best_free) if prefer_free else False
         if key_better or ((free == best_free or not prefer_free) and b - a > best_len):
             best, best_len, best_free = mid, b - a, free
     return float((f * (best - start)) % 1.0)
+
+
+def _compressed(sol: Any, which: list[int], t: float) -> bool:
+    """Whether any of the contactors ``which`` is pressed into its stop at ``t`` (``s w(a) > gap``)."""
+    if not which:
+        return False
+    cs = [sol.contactors[i] for i in which]
+    w = sol.sample(np.array([c.position for c in cs]), np.array([t])).w[0]
+    return any(c.direction * wi > c.gap for c, wi in zip(cs, w))
 
 
 def _settle(scenario: Scenario, multiple: int, settle_periods: float | None) -> tuple[Any, float, int]:
@@ -349,7 +361,7 @@ def periodic_orbit(
         from ..solver.ritz_space import RitzStateSpace
 
         # per-state modes (solver.basis = "paper", or a beam that can move as a rigid body)
-        prefer_free = not isinstance(sol.packed.space, RitzStateSpace)
+        prefer_free = not isinstance(sol.packed.space, RitzStateSpace) or bool(np.any(sol.packed.dash > 0.0))
         phase = _section_phase(sol, end - M / f, end, float(exc.start), f, prefer_free)
         pmap = StroboscopicMap(scenario, M, phase, n_modes)
         k0 = math.ceil(f * (end - exc.start) - M - phase - 1e-9)
