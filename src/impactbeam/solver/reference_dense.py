@@ -150,8 +150,14 @@ class IvpSolution(PiecewiseSolution):
             cand = [(float(val[k]), float(ts[k]))]
             for i0, i1 in ((k - 1, k), (k, k + 1)):
                 if 0 <= i0 and i1 < ts.size and der[i0] > 0 > der[i1]:
-                    r = brentq(lambda tt: float(u(tt)[1][0]), ts[i0], ts[i1], xtol=1e-15)
-                    cand.append((float(u(r)[0][0]), float(r)))
+                    slope = lambda tt: float(u(tt)[1][0])  # noqa: E731
+                    # the bracket judged again point by point: a slope of round-off size can change sign
+                    # between the grid's evaluation and a single point's (the stationary point is then an end)
+                    if slope(ts[i0]) > 0 > slope(ts[i1]):
+                        r = brentq(slope, ts[i0], ts[i1], xtol=1e-15)
+                        cand.append((float(u(r)[0][0]), float(r)))
+                    else:
+                        cand += [(float(val[i]), float(ts[i])) for i in (i0, i1)]
             v, tv = max(cand)
             if v > best:
                 best, tbest = v, tv
