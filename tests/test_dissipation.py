@@ -301,12 +301,10 @@ def test_bad_dissipation_input_names_the_key(make, match):
         make()
 
 
-def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
-    # Rayleigh beta = 1e-4 s on the enriched basis of a dashpot stop: the over-damped high coordinates all
-    # decay near 1/beta, so the block coordinates of that state are nearly dependent and cannot carry the
-    # state exactly. The refusal says which state, why, and what runs it (the solve_ivp path does).
+def _ill_conditioned_system(beta: float) -> dict:
+    """A spring-supported beam with a restitution stop, a dashpot stop and a spring stop, Rayleigh ``beta``."""
     L = 0.1092
-    sc = ib.parse_scenario({
+    return {
         "beam": {"length": L, "width": 9.93e-3, "height": 3.03e-3, "youngs_modulus": 1834e6, "density": 951.98},
         "supports": {"left": {"translational": 1e3, "rotational": 0.0}, "right": "sliding"},
         "masses": [{"position_ratio": 0.976, "mass": 1e-3, "rotary_inertia": 1e-9}],
@@ -314,10 +312,35 @@ def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
             {"position_ratio": 0.454, "stiffness": 316534.85, "gap": 1e-5, "side": "above", "restitution": 0.3},
             {"position_ratio": 0.676, "stiffness": 412.313, "gap": 1e-5, "side": "below", "damping": 0.136595},
             {"position_ratio": 0.873, "stiffness": 941.534, "gap": 0.0, "side": "below"}],
-        "damping": {"model": "rayleigh", "alpha": 0.0, "beta": 1e-4},
+        "damping": {"model": "rayleigh", "alpha": 0.0, "beta": beta},
         "excitation": {"kind": "point_force", "shape": "step", "amplitude": -0.2, "position": 0.01704},
         "solver": {"modes": 4, "time_step": 1e-5, "end_time": 0.02},
-    })
+    }
+
+
+def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
+    # Rayleigh beta = 1e-4 s on the enriched basis of a dashpot stop: the over-damped high coordinates all
+    # decay near 1/beta, so the block coordinates of that state are nearly dependent and cannot carry the
+    # state exactly. The refusal says which state, why, and what runs it (the solve_ivp path does).
+    sc = ib.parse_scenario(_ill_conditioned_system(1e-4))
     why = r'the state with contactors 1 engaged: .* eigenvalues lie within 1 % .*1/beta.*method = "ivp"'
     with pytest.raises(ib.SimulationError, match=why):
         ib.simulate(sc)
+
+
+def test_auto_modes_stop_at_the_last_count_that_can_run():
+    # Rayleigh beta = 1e-5 s on the same system: 4-12 modes run, 16 do not (the block coordinates of the
+    # state with the dashpot stop engaged agree with their inverse only to 3e-6; no eigenvalue cluster, so the
+    # refusal no longer blames one). "auto" at a tolerance it cannot meet returns the 12-mode run with its
+    # estimate, and says why it stopped, instead of failing the whole run.
+    raw = _ill_conditioned_system(1e-5)
+    raw["solver"].update(modes=16)
+    with pytest.raises(ib.SimulationError, match=r"agree only to .*lower the mode count, or run method = \"ivp\""):
+        ib.simulate(ib.parse_scenario(raw))
+    raw["solver"].update(modes="auto", tolerance=1e-9)
+    with pytest.warns(ib.ImpactBeamWarning) as record:
+        res = ib.simulate(ib.parse_scenario(raw))
+    assert res.n_modes == 12 and not res.converged
+    said = [str(w.message) for w in record]
+    assert any('"auto": 16 modes could not be run' in m and "12-mode run" in m for m in said)
+    assert any(m.startswith("not converged in the number of modes: with 12 modes") for m in said)

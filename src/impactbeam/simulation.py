@@ -200,11 +200,26 @@ def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> Simul
     each is estimated against the two counts before it, as a run with that
     fixed count is (:mod:`impactbeam.solver.convergence`). The result is that
     of the first count below the tolerance (or of the last count, with its
-    estimate and the unconverged warning).
+    estimate and the unconverged warning). A count that cannot be run (a
+    :class:`~impactbeam.exceptions.SimulationError`, e.g. a damping whose
+    block coordinates are ill-conditioned at that size) ends the ladder: the
+    previous count's result is returned with a warning saying why.
     """
+    from .exceptions import SimulationError
+
     done: dict[int, dict] = {}
+    res = None
     for n in AUTO_COUNTS:
-        res = run(n, announce=False)
+        try:
+            nxt = run(n, announce=False)
+        except SimulationError as exc:
+            if res is None:
+                raise
+            # a larger basis that cannot be run (an ill-conditioned damping): the last run stands, said so
+            warn(f'solver.modes = "auto": {n} modes could not be run ({exc}); the result is the {res.n_modes}-mode '
+                 "run, with its error estimate")
+            break
+        res = nxt
         done[n] = res.metrics()
         counts = coarser_counts(n)
         if all(c in done for c in counts):
@@ -212,6 +227,7 @@ def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> Simul
             res.set_convergence(metrics, peaks, counts)
             if max(metrics.values()) < tolerance:
                 break
+    assert res is not None  # the first count ran, or its error was raised
     for text in res.warnings:
         warn(text)
     return res

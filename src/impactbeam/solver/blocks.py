@@ -245,7 +245,6 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
         eigenvalues, a defective block of more than two).
     """
     n = omega.size
-    nc = Wc.shape[0]
     As, dscale, blocks, residual = block_structure(omega, C)
     if len(blocks) != n or residual > 1e-8:
         raise SimulationError(
@@ -274,12 +273,16 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
         om[k] = np.sqrt(w2)
     reg, wdh = _regimes(om, dec)
     Hm = np.linalg.inv(Gm)
-    if np.linalg.norm(Hm @ Gm - np.eye(2 * n), np.inf) > 1e-6:
+    miss = float(np.linalg.norm(Hm @ Gm - np.eye(2 * n), np.inf))
+    if miss > 1e-6:
+        near = _clustered(np.linalg.eigvals(As))
+        why = (f"{near} of its {2 * n} eigenvalues lie within 1 % of another; stiffness-proportional damping of "
+               "high modes, e.g. Rayleigh beta, puts their slow decay rates all near 1/beta); lower that damping or "
+               "the mode count" if near else
+               f"its {2 * n} coordinates and their inverse map agree only to {miss:.1g}); lower the mode count")
         raise SimulationError(
-            "non-proportional damping: the state's coordinates are too ill-conditioned to integrate exactly "
-            f"({_clustered(np.linalg.eigvals(As))} of its {2 * n} eigenvalues lie within 1 % of another; "
-            "stiffness-proportional damping of high modes, e.g. Rayleigh beta, puts their slow decay rates all "
-            'near 1/beta); lower that damping or the mode count, or run method = "ivp"'
+            f"non-proportional damping: the state's coordinates are too ill-conditioned to integrate exactly ({why}, "
+            'or run method = "ivp"'
         )
     G = np.stack([Gm[:, :n], Gm[:, n:]])
     H = np.stack([Hm[:n], Hm[n:]])
