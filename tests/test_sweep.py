@@ -172,6 +172,33 @@ metrics = ["max_response", "n_impacts"]
         sweep(path, None, workers=0, progress=False, on_error="raise")
 
 
+def test_auto_modes_are_stored_per_case(tmp_path):
+    """With solver.modes = "auto" each case's count is provenance: stored as ``modes``, as simulate chooses it."""
+    base = tomllib.loads(CASE3.read_text())
+    base["solver"].update(modes="auto", end_time=0.03)
+    scen = tmp_path / "auto.toml"
+    scen.write_bytes(tomli_w.dumps(base).encode())
+    text = f"""
+base = "{scen.as_posix()}"
+[parameters."contactors.0.gap"]
+values = ["0.1 mm", "0.3 mm"]
+[parameters."contactors.0.stiffness"]
+values = [4030.0, 1e6]
+[outputs]
+metrics = ["max_response", "n_impacts"]
+"""
+    ds = run_sweep(_write(tmp_path, "auto_sweep.toml", text), None, workers=0, progress=False).dataset
+    sc = ib.load_scenario(scen)
+    for gap in ds["contactors.0.gap"].values:
+        for k in ds["contactors.0.stiffness"].values:
+            want = ib.simulate(sc.with_values({"contactors.0.gap": float(gap), "contactors.0.stiffness": float(k)}))
+            assert int(ds["modes"].sel({"contactors.0.gap": gap, "contactors.0.stiffness": k})) == want.n_modes
+    assert int(ds["modes"].max()) > int(ds["modes"].min())  # the stiff stop needs more modes: not a constant
+    fixed = run_sweep(_write(tmp_path, "fixed.toml", text.replace(scen.as_posix(), CASE3.as_posix())), None,
+                      workers=0, progress=False).dataset
+    assert "modes" not in fixed  # a fixed count is in the scenario already
+
+
 def test_batches_group_cases_that_share_the_modes(tmp_path):
     """Geometry parameters get chunk 1, so a batch holds one geometry; its cases hit the mode cache."""
     text = f"""

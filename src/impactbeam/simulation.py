@@ -452,12 +452,15 @@ class CaseMetrics:
         The solver's message, or the error of a failed case.
     errors : list of Exception or None
         The exception of each failed case.
+    modes : ndarray of int, (n_cases,)
+        Modes per state of each run (what ``solver.modes = "auto"`` chose); 0 for a failed case.
     """
 
     scalars: np.ndarray
     status: np.ndarray
     messages: list[str]
     errors: list[BaseException | None] = field(default_factory=list)
+    modes: np.ndarray | None = None
 
 
 def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None = None) -> CaseMetrics:
@@ -487,6 +490,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
     n = len(cases)
     scalars = np.full((n, len(METRIC_UNITS)), np.nan)
     status = np.full(n, -1, dtype=np.int64)
+    modes = np.zeros(n, dtype=np.int64)
     messages = [""] * n
     errors: list[BaseException | None] = [None] * n
     groups: dict[tuple, list[int]] = {}
@@ -519,6 +523,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
             else:
                 scalars[ks[0]] = [np.nan if m[name] is None else m[name] for name in METRIC_UNITS]
                 status[ks[0]] = res.status
+                modes[ks[0]] = res.n_modes
                 messages[ks[0]] = res.message
             done += 1
         else:
@@ -532,6 +537,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
                                      progress=None if progress is None else (lambda j, done=done: progress(done + j)))
                 scalars[part] = br.scalars
                 status[part] = br.status
+                modes[part] = np.where(br.status >= 0, int(first.options.modes), 0)
                 for j, k in enumerate(part):
                     messages[k] = br.messages[j]
                     errors[k] = br.errors[j]
@@ -540,7 +546,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
                 done += len(part)
         if progress is not None:
             progress(done)
-    return CaseMetrics(scalars, status, messages, errors)
+    return CaseMetrics(scalars, status, messages, errors, modes)
 
 
 #: Bytes of load pieces one compiled batch may hold (a batch pads every case's pieces to the longest).

@@ -298,6 +298,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     n = len(batch.values)
     out: dict[str, Any] = {m: np.full(n, np.nan) for m in batch.metrics}
     status = np.full(n, FAILED, dtype=np.int8)
+    out["modes"] = np.zeros(n, dtype=np.int16)  # modes per state of each case (stored with solver.modes = "auto")
     message = [""] * n
     builder = _builder(batch)
     whole = batch.history_times is not None or batch.statistics or not set(batch.metrics) <= set(METRIC_UNITS)
@@ -321,6 +322,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
             for m, col in zip(batch.metrics, columns):
                 out[m][lo + k] = res.scalars[j, col]
             status[lo + k] = res.status[j]
+            out["modes"][lo + k] = res.modes[j]
             message[lo + k] = "" if res.status[j] == 0 else " ".join(str(res.messages[j]).split())
         if step == 1 and ok:  # then as many at once as the batch memory allows
             step = max(1, BATCH_BYTES // max(case_bytes(built[ok[0]]), 1))
@@ -362,6 +364,7 @@ def _run_one_by_one(batch: _Batch, base: Any, out: dict[str, Any], status: np.nd
         for name, arr in stats.items():
             arr[k] = record[name]
         status[k] = res.status
+        out["modes"][k] = res.n_modes
         message[k] = "" if res.status == 0 else " ".join(str(res.message).split())
     out.update(stats)
     out["status"] = status

@@ -140,7 +140,10 @@ class _Writer:
         zarr = require("zarr", "sweep")
 
         self.group = zarr.open_group(store, mode="r+")
-        self.arrays = {name: self.group[name] for name in (*spec.metrics, *statistic_names(spec), "message", "status")}
+        names = (*spec.metrics, *statistic_names(spec), "message", "status")
+        self.arrays = {name: self.group[name] for name in names}
+        if "modes" in self.group:  # solver.modes = "auto" (a store made before it was recorded has none)
+            self.arrays["modes"] = self.group["modes"]
         if spec.histories is not None:
             self.arrays["w"] = self.group["w"]
         self._threads: Any = None
