@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -329,18 +330,28 @@ def test_an_ill_conditioned_damping_is_refused_naming_its_state_and_a_way_on():
 
 
 def test_auto_modes_stop_at_the_last_count_that_can_run():
-    # Rayleigh beta = 1e-5 s on the same system: 4-12 modes run, 16 do not (the block coordinates of the
-    # state with the dashpot stop engaged agree with their inverse only to 3e-6; no eigenvalue cluster, so the
-    # refusal no longer blames one). "auto" at a tolerance it cannot meet returns the 12-mode run with its
-    # estimate, and says why it stopped, instead of failing the whole run.
+    # Rayleigh beta = 1e-5 s on the same system: the smaller counts run, a larger one does not (measured: 4-12
+    # run, 16 is refused, its block coordinates agreeing with their inverse only to 3e-6 against the 1e-6
+    # asked; no eigenvalue cluster, so the refusal no longer blames one). "auto" at a tolerance it cannot meet
+    # returns the last count that runs, with its estimate, and says why it stopped, instead of failing the run.
+    # The first refused count is found here, not assumed: another LAPACK may put the limit one count further.
     raw = _ill_conditioned_system(1e-5)
-    raw["solver"].update(modes=16)
-    with pytest.raises(ib.SimulationError, match=r"agree only to .*lower the mode count, or run method = \"ivp\""):
-        ib.simulate(ib.parse_scenario(raw))
+    counts = [4, 6, 8, 12, 16, 24, 32]
+    refused = message = None
+    for n in counts:
+        raw["solver"].update(modes=n)
+        try:
+            ib.simulate(ib.parse_scenario(raw))
+        except ib.SimulationError as exc:
+            refused, message = n, str(exc)
+            break
+    assert refused is not None and refused >= 12
+    assert re.search(r'agree only to .*lower the mode count, or run method = "ivp"', message)
+    last = counts[counts.index(refused) - 1]
     raw["solver"].update(modes="auto", tolerance=1e-9)
     with pytest.warns(ib.ImpactBeamWarning) as record:
         res = ib.simulate(ib.parse_scenario(raw))
-    assert res.n_modes == 12 and not res.converged
+    assert res.n_modes == last and not res.converged
     said = [str(w.message) for w in record]
-    assert any('"auto": 16 modes could not be run' in m and "12-mode run" in m for m in said)
-    assert any(m.startswith("not converged in the number of modes: with 12 modes") for m in said)
+    assert any(f'"auto": {refused} modes could not be run' in m and f"{last}-mode run" in m for m in said)
+    assert any(m.startswith(f"not converged in the number of modes: with {last} modes") for m in said)
