@@ -238,10 +238,6 @@ def bifurcation(
         A value whose period is not found is run on up to this many settling
         periods (default ``10 * settle_periods``;
         :func:`~impactbeam.periodic.strobe.steady_state`).
-
-    With ``solver.modes = "auto"`` the first value's run chooses the mode
-    count and every value is run with it (``point.state.result.n_modes``):
-    continuation carries the modal state from one value to the next.
     progress : callable, optional
         ``progress(done, total)`` after each value.
 
@@ -250,6 +246,12 @@ def bifurcation(
     BifurcationDiagram
         ``points`` in the order computed; ``warnings`` lists every value
         whose period was not found (also issued as ImpactBeamWarning).
+
+    Notes
+    -----
+    With ``solver.modes = "auto"`` the first value's run chooses the mode
+    count and every value is run with it (``point.state.result.n_modes``):
+    continuation carries the modal state from one value to the next.
 
     Examples
     --------

@@ -109,11 +109,15 @@ def linear_steady_state(scenario: Scenario) -> ModalState:
     stays on the linear steady state as long as no contactor is touched:
     a start with no transient for frequency-response curves and tests.
     """
-    from ..solver.solution import ModalState, basis_signature
-
     harmonic_period(scenario)
     pk, opt = _free_state(scenario)
-    q = _complex_amplitudes(pk, scenario)
+    return _steady_state(pk, opt, scenario, _complex_amplitudes(pk, scenario))
+
+
+def _steady_state(pk: Any, opt: Any, scenario: Scenario, q: np.ndarray) -> ModalState:
+    """:func:`linear_steady_state` from the complex amplitudes ``q`` of the free state's modes."""
+    from ..solver.solution import ModalState, basis_signature
+
     Om = 2.0 * np.pi * float(scenario.excitation.frequency)  # type: ignore[arg-type]
     basis = basis_signature(scenario.beam, scenario.contactors, int(opt.modes), opt.basis, scenario.excitation)
     return ModalState(0.0, np.ascontiguousarray(q.imag), np.ascontiguousarray((1j * Om * q).imag), basis)
@@ -146,17 +150,18 @@ def linear_limit(scenario: Scenario, start: ModalState | None) -> ModalState | N
         return None
     if start is None and not scenario.initial.at_rest:
         return None
-    pk, _ = _free_state(scenario)
+    pk, opt = _free_state(scenario)
     om, dec, wd = pk.om[0], pk.dec[0], pk.wdh[0]
     if pk.gen[0] or np.any(pk.reg[0] != 0) or not np.all(dec > 0.0) or np.any(pk.pre[0] != 0.0):
         return None
-    steady = linear_steady_state(scenario)
+    q = _complex_amplitudes(pk, scenario)
+    steady = _steady_state(pk, opt, scenario, q)
     if start is not None and start.basis != steady.basis:
         return None
     a = np.zeros_like(om) if start is None else start.eta - steady.eta
     b = np.zeros_like(om) if start is None else start.deta - steady.deta
     R = np.hypot(a, (b + dec * a) / wd)
     Wc = pk.Wc[0]  # (n_contactors, n_modes)
-    reach = np.abs(Wc @ _complex_amplitudes(pk, scenario)) + np.abs(Wc) @ R
+    reach = np.abs(Wc @ q) + np.abs(Wc) @ R
     gaps = np.array([c.gap for c in scenario.contactors], dtype=float)
     return steady if bool(np.all(reach < CLEAR_FRACTION * gaps)) else None

@@ -248,12 +248,12 @@ def _section_phase(sol: Any, lo: float, hi: float, start: float, f: float, prefe
 
 
 def _compressed(sol: Any, which: list[int], t: float) -> bool:
-    """Whether any of the contactors ``which`` is pressed into its stop at ``t`` (``s w(a) > gap``)."""
+    """Whether any of the contactors ``which`` is pressed into its stop at ``t`` (its opening negative)."""
     if not which:
         return False
     cs = [sol.contactors[i] for i in which]
     w = sol.sample(np.array([c.position for c in cs]), np.array([t])).w[0]
-    return any(c.direction * wi > c.gap for c, wi in zip(cs, w))
+    return any(c.gap_function(float(wi)) < 0.0 for c, wi in zip(cs, w))
 
 
 def _settle(scenario: Scenario, multiple: int, settle_periods: float | None) -> tuple[Any, float, int]:
