@@ -251,6 +251,7 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
                 c = con[rc[i]]
                 w = sol.sample(np.array([c.position]), np.array([ra[i], rbe[i]])).w[:, 0]
                 d0[i], d1[i] = c.direction * w - c.gap
+        fpeaks, ints = _forces(result, rc, ra, rbe, fpeaks, np.asarray(ints, dtype=float), d0, d1)
     return out, (rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1)
 
 
@@ -305,46 +306,47 @@ def contact_forces(result: ResultLike, intervals: Sequence[tuple[int, float, flo
         col = np.searchsorted(xs, [cs[i].position for i in forced])
         for j, i in enumerate(forced):
             d0[i], d1[i] = cs[i].direction * w[2 * j: 2 * j + 2, col[j]] - cs[i].gap
-    return _forces(result, intervals, peaks, ints, d0, d1)
+    ci, a, b = (np.array(v) for v in zip(*intervals))
+    return _forces(result, ci.astype(np.int64), a.astype(float), b.astype(float), peaks, np.asarray(ints, dtype=float),
+                   d0, d1)
 
 
-def _forces(result: ResultLike, intervals: Sequence[tuple[int, float, float]], peaks: Sequence[float],
-            ints: Sequence[float], d0: Sequence[float], d1: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """The rule of :func:`contact_forces`: peak ``k max(peak, 0)``, impulse ``k (s int w - gap T) + c_d [d]``.
+def _forces(result: ResultLike, contactor: np.ndarray, start: np.ndarray, end: np.ndarray, peaks: np.ndarray,
+            ints: np.ndarray, d0: np.ndarray, d1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Peak forces and impulses of intervals ``(contactor, start, end)`` by the compiled rule
+    (:func:`~impactbeam.solver._metrics.impact_forces`: ``k max(peak, 0)`` and ``k (s int w - gap T) +
+    c_d [d]``).
 
     ``peaks`` are the maxima of ``d + (c_d / k) d'`` (of ``d`` without
     dashpot), ``ints`` the integrals of ``w`` at the contactor, ``d0, d1`` the
     compressions at the ends (read only with a dashpot).
     """
+    from ..solver import kernels
+
     con = result.contactors
-    dash = np.asarray(getattr(result.solution, "dashpots", np.zeros(len(con))), dtype=float).tolist()
-    k, s, gap = [c.stiffness for c in con], [c.direction for c in con], [c.gap for c in con]
-    force, impulse = [], []
-    for (ci, a, b), peak, iw, e0, e1 in zip(intervals, peaks, ints, d0, d1):
-        force.append(k[ci] * max(peak, 0.0))
-        imp = k[ci] * (s[ci] * iw - gap[ci] * (b - a))
-        if dash[ci] > 0.0:
-            imp += dash[ci] * (e1 - e0)
-        impulse.append(imp)
-    return np.array(force, dtype=float), np.array(impulse, dtype=float)
+    n = len(peaks)
+    force = np.array(peaks, dtype=float)
+    impulse = np.array(ints, dtype=float)
+    kernels.for_work(n).impact_forces(
+        np.asarray(contactor, dtype=np.int64), np.asarray(start, dtype=float), np.asarray(end, dtype=float), force,
+        impulse, np.asarray(d0, dtype=float), np.asarray(d1, dtype=float), n,
+        np.array([c.direction for c in con], dtype=float), np.array([c.gap for c in con], dtype=float),
+        np.array([c.stiffness for c in con], dtype=float),
+        np.asarray(getattr(result.solution, "dashpots", np.zeros(len(con))), dtype=float))
+    return force, impulse
 
 
 def _impact_table(result: ResultLike, rows: tuple) -> list[dict[str, Any]]:
-    """Duration, peak force and impulse of every contact interval (exact, closed form; :func:`_forces`)."""
-    rc, ra, rb, rbe, _, fpeaks, ints, d0, d1 = (r.tolist() for r in rows)
-    force, impulse = _forces(result, list(zip(rc, ra, rbe)), fpeaks, ints, d0, d1)
-    out = []
-    for ci, a, b, peak, imp in zip(rc, ra, rb, force.tolist(), impulse.tolist()):
-        finite = math.isfinite(b)
-        out.append(
-            {
-                "contactor": ci,
-                "start": a,
-                "end": b if finite else None,
-                "duration": (b - a) if finite else None,
-                "peak_force": peak,
-                "impulse": imp,
-            }
-        )
-    out.sort(key=lambda d: (d["start"], d["contactor"]))
-    return out
+    """Duration, peak force and impulse of every contact interval (exact, closed form), by start time.
+
+    ``rows`` as :meth:`~impactbeam.solver.solution.Solution.metric_arrays`
+    returns them (the peak forces and impulses already by :func:`_forces`'s rule).
+    """
+    rc, ra, rb, _, _, force, impulse, _, _ = rows
+    order = np.lexsort((rc, ra))  # by start, then contactor
+    return [
+        {"contactor": ci, "start": a, "end": b if b != math.inf else None, "duration": (b - a) if b != math.inf else None,
+         "peak_force": peak, "impulse": imp}
+        for ci, a, b, peak, imp in zip(rc[order].tolist(), ra[order].tolist(), rb[order].tolist(),
+                                       force[order].tolist(), impulse[order].tolist())
+    ]

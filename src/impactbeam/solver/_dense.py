@@ -19,9 +19,10 @@ and evaluate it.
   the left half (its mirror on the right), which is what drops the many
   near-equal peaks of a steady-state record early. Sub-intervals that cannot
   beat the best value found (to ``atol``) are dropped, the others are split, and an
-  interior maximum (slope ``+`` to ``-``) is refined by Brent's method on the
-  velocity. The result is the maximum of the N-mode solution to ``atol``,
-  not of any sampled grid.
+  interior maximum (slope ``+`` to ``-``, ``u''`` proven negative) is refined
+  by Newton's method on the velocity with the curvature each evaluation
+  gives. The result is the maximum of the N-mode solution to ``atol``, not
+  of any sampled grid.
 * :func:`integral` integrates ``W eta`` in closed form
   (:func:`~impactbeam.solver._closed.integral_of`), e.g. impulses.
 """
@@ -38,14 +39,13 @@ from ._closed import (
     segment_setup, sincos, state_at, workspace,
 )
 from ._elementary import ROW_C, ROW_S, kernel_work, kernels_at
-from ._events import SLOPE, brent
+from ._events import RTOL
 from ._loop import load_value, to_modal
 
 __all__ = ["sample", "extremum", "extremum_query", "integral", "integral_query", "first_segment", "dense_work",
            "row_ceiling"]
 
-ROW0 = np.int64(0)  # int64 values, not literals: one compiled specialisation of brent and project
-ONE_ROW = np.int64(1)
+ONE_ROW = np.int64(1)  # an int64 value, not a literal: one compiled specialisation of project
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -290,6 +290,43 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cove
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def _concave_peak(t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover
+    """The maximum of row 0 on ``[t0, t1]`` where ``u'' < 0`` and ``u'`` goes from ``d0 > 0`` to ``d1 < 0``.
+
+    Newton's method on ``u'`` with the ``u''`` each evaluation of
+    :func:`_row3` already gives, kept inside the bracket of the sign change
+    (bisection when a step would leave it), from the secant point of the
+    slopes; it stops when the step or the bracket is below Brent's
+    tolerance ``(xtol + 4 eps |t|) / 2`` (the value's error is then of the
+    order of ``|u''| step^2``). Returns the time and the value there.
+    """
+    lo = t0
+    hi = t1
+    t = t0 + (t1 - t0) * (d0 / (d0 - d1))
+    if not (lo < t < hi):
+        t = 0.5 * (lo + hi)
+    u = -np.inf
+    for _ in range(200):
+        u, du, ddu = _row3(t, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+        if du == 0.0:
+            break
+        if du > 0.0:
+            lo = t
+        else:
+            hi = t
+        delta = 0.5 * (xtol + RTOL * abs(t))
+        if hi - lo < 2.0 * delta:
+            break
+        if ddu < 0.0 and abs(du) < delta * -ddu:
+            break  # the next Newton step would be below the tolerance
+        tn = t - du / ddu if ddu < 0.0 else lo - 1.0
+        if not (lo < tn < hi):
+            tn = 0.5 * (lo + hi)
+        t = tn
+    return t, u
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):
     # pragma: no cover - compiled
     """Branch and bound for the maximum of row 0 on ``[ta, tb]`` (module docstring).
@@ -341,16 +378,18 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
         concave = c0 < 0.0 and c1 < 0.0 and -(c0 + c1) >= M3 * L
         if concave and not (d0 > 0.0 and d1 < 0.0):
             continue  # concave with no interior stationary point: the ends hold the maximum
+        if concave:  # the one interior maximum: the root of u' by Newton's method with u''
+            tm, um = _concave_peak(t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+            if um > best:
+                best = um
+                tbest = tm
+            continue
         tm = 0.5 * (t0 + t1)
-        if concave:  # the one interior maximum: Brent on u'
-            tm = brent(SLOPE, ROW0, t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
-            if not (t0 < tm < t1):
-                tm = 0.5 * (t0 + t1)
         um, dm, cm = _row3(tm, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
         if um > best:
             best = um
             tbest = tm
-        if concave or top + 2 > stack.shape[0]:
+        if top + 2 > stack.shape[0]:
             continue
         stack[top, 0] = tm
         stack[top, 1] = um

@@ -33,7 +33,8 @@ import numpy as np
 from ._dense import extremum_query, integral_query, sample_row
 from ._jit import njit
 
-__all__ = ["N_SCALARS", "SCALARS", "contact_rows", "assemble", "run_metrics", "pairwise_sum", "release_loss_sum"]
+__all__ = ["N_SCALARS", "SCALARS", "contact_rows", "assemble", "run_metrics", "impact_forces", "pairwise_sum",
+           "release_loss_sum"]
 
 #: Order of the scalar metrics in the arrays of this module (NaN where undefined).
 SCALARS = ("max_response", "t_max", "first_impact_time", "n_impacts", "free_duration", "contact_duration",
@@ -217,6 +218,31 @@ def assemble(out, nev, top, t_top, low, energy_residual, deepest, n_rows, rc, ra
         out[MIN_RESPONSE] = -(peak + gap0)
 
 
+@njit(cache=True, nogil=True, _nrt=False)
+def impact_forces(rc, ra, rbe, fpeaks, ints, d0, d1, n, side, gap, kst, dash):  # pragma: no cover - compiled
+    """Peak force and impulse of contact intervals, in place of ``fpeaks`` and ``ints`` (the rule of
+    :func:`impactbeam.result.metrics.contact_forces`).
+
+    Row ``i`` of contactor ``c = rc[i]`` on ``[ra[i], rbe[i]]``: ``fpeaks[i]``,
+    the largest ``d + (c_d / k) d'`` (``d = s w - gap`` the compression),
+    becomes the peak force ``k max(fpeaks[i], 0)``; ``ints[i] = int w dt``
+    becomes the impulse ``k (s int w dt - gap (rbe - ra)) + c_d (d1 - d0)``,
+    the dashpot's share from the compressions ``d0, d1`` at the ends (read
+    only when ``c_d > 0``).
+    """
+    for i in range(n):
+        c = rc[i]
+        k = kst[c]
+        p = fpeaks[i]
+        if 0.0 > p:
+            p = 0.0
+        fpeaks[i] = k * p
+        imp = k * (side[c] * ints[i] - gap[c] * (rbe[i] - ra[i]))
+        if dash[c] > 0.0:
+            imp += dash[c] * (d1[i] - d0[i])
+        ints[i] = imp
+
+
 @njit(cache=True, nogil=True)
 def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_d, nev, jumps, t_end,
                 reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, dash, pt0, pconst, pslope, pamp, pOm,
@@ -229,9 +255,9 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
     event arrays hold exactly the run's records. ``out`` receives the
     scalars; the row arrays (at least ``nev + n_contactors`` long) the
     per-impact table: contactor, start, end, clipped end, peak compression
-    ``s w - gap``, and with ``table`` the peak of ``k d + c d'`` over ``k``
-    (``fpeaks``), ``int w dt`` (``ints``) and the compression at both ends of
-    dashpot contactors (``d0, d1``; NaN for the others). ``work`` from
+    ``s w - gap``, and with ``table`` the peak force (``fpeaks``) and the
+    impulse (``ints``) of :func:`impact_forces` and the compression at both
+    ends of dashpot contactors (``d0, d1``; NaN for the others). ``work`` from
     :func:`~impactbeam.solver._dense.dense_work`, its last array resized to
     ``nev`` floats by the caller's ``scratch``.
     """
@@ -303,4 +329,5 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
                 d1[i] = side[c] * sample_row(rbe[i], Wc[c], seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh,
                                              om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp,
                                              pOm, pphase, work) - gap[c]
+        impact_forces(rc, ra, rbe, fpeaks, ints, d0, d1, n_rows, side, gap, kst, dash)
     return n_rows

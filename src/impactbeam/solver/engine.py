@@ -119,6 +119,7 @@ class _Packed:
         self.tr_to = np.full(4, -1, dtype=np.int64)
         self.ntr = 0
         self._rows: dict[bytes, np.ndarray] = {}
+        self._metric_rows: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
         self.add_state(0)
 
     @property
@@ -136,6 +137,18 @@ class _Packed:
             new = [st.modes.shapes(x).T for st in self.models[done:]]
             hit = np.ascontiguousarray(np.stack(new if hit is None else [*hit, *new]))
             self._rows[key] = hit
+        return hit
+
+    def metric_rows(self, x: float, positions: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Shapes at ``x`` (S, n) and at each of ``positions`` (n_c, S, n) in every built state, cached."""
+        key = (x, positions, self.nslots)
+        hit = self._metric_rows.get(key)
+        if hit is None:
+            Wm = self.rows(np.array([x], dtype=float))[:, 0, :]
+            Wc = np.zeros((max(len(positions), 1),) + Wm.shape)
+            for c, p in enumerate(positions):
+                Wc[c] = self.rows(np.array([p], dtype=float))[:, 0, :]
+            hit = self._metric_rows[key] = (np.ascontiguousarray(Wm), Wc)
         return hit
 
     @property

@@ -451,8 +451,9 @@ class Solution(PiecewiseSolution):
             In the order of :data:`~impactbeam.solver._metrics.SCALARS`, NaN where undefined.
         rows : tuple of ndarray
             Contactor, start, end, clipped end, peak compression, peak force
-            over stiffness, ``int w dt`` and the compression at both ends
-            (NaN without a dashpot), one entry per contact interval.
+            [N], impulse [N s] and the compression at both ends (NaN without
+            a dashpot), one entry per contact interval (the last five with
+            ``table`` only).
         """
         K = kernels.for_work(self.n_segments + self.event_arrays[0].size)
         pk = self.packed
@@ -472,7 +473,8 @@ class Solution(PiecewiseSolution):
         return out, tuple(r[:n_rows] for r in rows)
 
     def metric_rows(self, x: float) -> tuple[np.ndarray, np.ndarray]:
-        """Shapes at ``x`` (S, n) and at each contactor (n_c, S, n) in every built state slot (cached per position).
+        """Shapes at ``x`` (S, n) and at each contactor (n_c, S, n) in every built state slot (cached per position,
+        here and by the packed problem for the runs that share it).
 
         Parameters
         ----------
@@ -481,12 +483,7 @@ class Solution(PiecewiseSolution):
         """
         hit = self._metric_rows.get(x)
         if hit is None:
-            Wm = self.rows(np.array([x], dtype=float))[:, 0, :]
-            nc = len(self.contactors)
-            Wc = np.zeros((max(nc, 1),) + Wm.shape)
-            for c, con in enumerate(self.contactors):
-                Wc[c] = self.rows(np.array([con.position], dtype=float))[:, 0, :]
-            hit = self._metric_rows[x] = (np.ascontiguousarray(Wm), Wc)
+            hit = self._metric_rows[x] = self.packed.metric_rows(x, tuple(c.position for c in self.contactors))
         return hit
 
     def _row_table(self, xs: list[float]) -> tuple[np.ndarray, np.ndarray]:
