@@ -327,6 +327,19 @@ def _concave_peak(t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def _push(stack, i, t0, u0, d0, c0, t1, u1, d1, c1):  # pragma: no cover - compiled
+    """Row ``i`` of the branch-and-bound stack: an interval with value, slope and curvature at both ends."""
+    stack[i, 0] = t0
+    stack[i, 1] = u0
+    stack[i, 2] = d0
+    stack[i, 3] = c0
+    stack[i, 4] = t1
+    stack[i, 5] = u1
+    stack[i, 6] = d1
+    stack[i, 7] = c1
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):
     # pragma: no cover - compiled
     """Branch and bound for the maximum of row 0 on ``[ta, tb]`` (module docstring).
@@ -347,14 +360,7 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
     if ub > best:
         best = ub
         tbest = tb
-    stack[0, 0] = ta
-    stack[0, 1] = ua
-    stack[0, 2] = da
-    stack[0, 3] = ca
-    stack[0, 4] = tb
-    stack[0, 5] = ub
-    stack[0, 6] = db
-    stack[0, 7] = cb
+    _push(stack, 0, ta, ua, da, ca, tb, ub, db, cb)
     top = 1
     while top > 0:
         top -= 1
@@ -391,22 +397,14 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
             tbest = tm
         if top + 2 > stack.shape[0]:
             continue
-        stack[top, 0] = tm
-        stack[top, 1] = um
-        stack[top, 2] = dm
-        stack[top, 3] = cm
-        stack[top, 4] = t1
-        stack[top, 5] = u1
-        stack[top, 6] = d1
-        stack[top, 7] = c1
-        stack[top + 1, 0] = t0
-        stack[top + 1, 1] = u0
-        stack[top + 1, 2] = d0
-        stack[top + 1, 3] = c0
-        stack[top + 1, 4] = tm
-        stack[top + 1, 5] = um
-        stack[top + 1, 6] = dm
-        stack[top + 1, 7] = cm
+        # the half where u' turns from + to - (the right one when u'(tm) > 0) is searched first: its maximum
+        # is then known before the other half's bound is tested, which usually drops that half unsplit
+        if dm > 0.0:
+            _push(stack, top, t0, u0, d0, c0, tm, um, dm, cm)
+            _push(stack, top + 1, tm, um, dm, cm, t1, u1, d1, c1)
+        else:
+            _push(stack, top, tm, um, dm, cm, t1, u1, d1, c1)
+            _push(stack, top + 1, t0, u0, d0, c0, tm, um, dm, cm)
         top += 2
     return best, tbest
 
