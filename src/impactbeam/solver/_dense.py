@@ -296,8 +296,8 @@ def _concave_peak(t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi
     Newton's method on ``u'`` with the ``u''`` each evaluation of
     :func:`_row3` already gives, kept inside the bracket of the sign change
     (bisection when a step would leave it), from the secant point of the
-    slopes; it stops when the step or the bracket is below Brent's
-    tolerance ``(xtol + 4 eps |t|) / 2`` (the value's error is then of the
+    slopes; it stops when the step or the bracket is below the event
+    refinement's tolerance ``(xtol + 4 eps |t|) / 2`` (the value's error is then of the
     order of ``|u''| step^2``). Returns the time and the value there.
     """
     lo = t0
@@ -348,8 +348,9 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
     done when its upper bound cannot beat ``best``, when ``u`` is proven
     monotone on it (the maximum is then at an end), or when ``u`` is proven
     concave on it (``u'' < 0`` at both ends and ``|u''(t0)| + |u''(t1)| >= M3 L``;
-    the maximum is then the root of ``u'`` found by Brent's method, or an end).
-    Returns the new best value and its time, NaN when ``best`` was not beaten.
+    the maximum is then the root of ``u'``, :func:`_concave_peak`, or an end).
+    The half where ``u'`` turns from + to - is searched first. Returns the
+    new best value and its time, NaN when ``best`` was not beaten.
     """
     tbest = np.nan
     ua, da, ca = _row3(ta, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
