@@ -345,8 +345,8 @@ def _impact_table(result: ResultLike, rows: tuple) -> list[dict[str, Any]]:
     rc, ra, rb, _, _, force, impulse, _, _ = rows
     order = np.lexsort((rc, ra))  # by start, then contactor
     return [
-        {"contactor": ci, "start": a, "end": b if b != math.inf else None, "duration": (b - a) if b != math.inf else None,
-         "peak_force": peak, "impulse": imp}
+        {"contactor": ci, "start": a, "end": b if b != math.inf else None,
+         "duration": (b - a) if b != math.inf else None, "peak_force": peak, "impulse": imp}
         for ci, a, b, peak, imp in zip(rc[order].tolist(), ra[order].tolist(), rb[order].tolist(),
                                        force[order].tolist(), impulse[order].tolist())
     ]
