@@ -313,11 +313,10 @@ def contact_forces(result: ResultLike, intervals: Sequence[tuple[int, float, flo
 
 def _forces(result: ResultLike, contactor: np.ndarray, start: np.ndarray, end: np.ndarray, peaks: np.ndarray,
             ints: np.ndarray, d0: np.ndarray, d1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Peak forces and impulses of intervals ``(contactor, start, end)`` by the compiled rule
-    (:func:`~impactbeam.solver._metrics.impact_forces`: ``k max(peak, 0)`` and ``k (s int w - gap T) +
-    c_d [d]``).
+    """Peak forces and impulses of contact intervals ``(contactor, start, end)``, by the compiled rule.
 
-    ``peaks`` are the maxima of ``d + (c_d / k) d'`` (of ``d`` without
+    :func:`~impactbeam.solver._metrics.impact_forces`: ``k max(peak, 0)`` and
+    ``k (s int w - gap T) + c_d [d]``. ``peaks`` are the maxima of ``d + (c_d / k) d'`` (of ``d`` without
     dashpot), ``ints`` the integrals of ``w`` at the contactor, ``d0, d1`` the
     compressions at the ends (read only with a dashpot).
     """
