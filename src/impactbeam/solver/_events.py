@@ -140,6 +140,41 @@ def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, p
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def _crossing(c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover
+    """The root of ``h_c`` in ``[t0, t1]``, where it goes from ``g0 > 0`` to ``g1 <= 0``.
+
+    Newton's method with the slope that each evaluation (:func:`row_at`)
+    gives with the value, kept inside the bracket of the sign change
+    (bisection when a step would leave it), from the secant point; it stops
+    when the next step or the bracket is below :func:`brent`'s tolerance
+    ``(xtol + 4 eps |t|) / 2``.
+    """
+    if g1 == 0.0:
+        return t1
+    lo = t0
+    hi = t1
+    t = t0 + (t1 - t0) * (g0 / (g0 - g1))
+    if not (lo < t < hi):
+        t = 0.5 * (lo + hi)
+    for _ in range(200):
+        g, dg = row_at(c, t, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+        if g == 0.0:
+            break
+        if g > 0.0:
+            lo = t
+        else:
+            hi = t
+        delta = 0.5 * (xtol + RTOL * abs(t))
+        if hi - lo < 2.0 * delta or (dg < 0.0 and abs(g) < delta * -dg):
+            break
+        tn = t - g / dg if dg < 0.0 else lo - 1.0
+        if not (lo < tn < hi):
+            tn = 0.5 * (lo + hi)
+        t = tn
+    return t
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def safe_step(h, dh, M):  # pragma: no cover - compiled
     """Largest ``s`` with ``h + dh s - M s^2/2 > 0`` (``h > 0``); inf if unbounded."""
     if M <= 0.0:
@@ -194,7 +229,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
                 if M <= 0.0 or safe_step(g0 + tol_h, d0, M) + safe_step(g1 + tol_h, -d1, M) >= L:
                     continue
             elif not touch0 and (_monotone(d0, d1, M, L, -1.0) or L <= xtol):
-                return brent(VALUE, c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+                return _crossing(c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
             elif touch0 and L <= xtol:
                 return t0  # from the surface straight into the stop
             if L <= xtol:
