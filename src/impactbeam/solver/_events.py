@@ -165,11 +165,13 @@ def _crossing(c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi,
         else:
             hi = t
         delta = 0.5 * (xtol + RTOL * abs(t))
-        if hi - lo < 2.0 * delta or (dg < 0.0 and abs(g) < delta * -dg):
+        if hi - lo < 2.0 * delta:
             break
         tn = t - g / dg if dg < 0.0 else lo - 1.0
         if not (lo < tn < hi):
             tn = 0.5 * (lo + hi)
+        elif abs(tn - t) < delta:
+            return tn  # the last Newton step, below the tolerance: its error is of the order of its square
         t = tn
     return t
 
