@@ -39,7 +39,7 @@ from ._closed import (
     segment_setup, sincos, state_at, workspace,
 )
 from ._elementary import ROW_C, ROW_S, kernel_work, kernels_at
-from ._events import RTOL
+from ._events import newton_step, secant_start
 from ._loop import load_value, to_modal
 
 __all__ = ["sample", "extremum", "extremum_query", "integral", "integral_query", "first_segment", "dense_work",
@@ -293,35 +293,23 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cove
 def _concave_peak(t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover
     """The maximum of row 0 on ``[t0, t1]`` where ``u'' < 0`` and ``u'`` goes from ``d0 > 0`` to ``d1 < 0``.
 
-    Newton's method on ``u'`` with the ``u''`` each evaluation of
-    :func:`_row3` already gives, kept inside the bracket of the sign change
-    (bisection when a step would leave it), from the secant point of the
-    slopes; it stops when the step or the bracket is below the event
-    refinement's tolerance ``(xtol + 4 eps |t|) / 2`` (the value's error is then of the
-    order of ``|u''| step^2``). Returns the time and the value there.
+    Newton's method on ``u'`` (:func:`~impactbeam.solver._events.newton_step`)
+    with the ``u''`` each evaluation of :func:`_row3` already gives, from the
+    secant point of the slopes. Returns the last point evaluated and the value
+    there: within the tolerance of the maximum's time, so the value's error
+    is of the order of ``|u''|`` times its square.
     """
     lo = t0
     hi = t1
-    t = t0 + (t1 - t0) * (d0 / (d0 - d1))
-    if not (lo < t < hi):
-        t = 0.5 * (lo + hi)
+    t = secant_start(t0, t1, d0, d1)
     u = -np.inf
     for _ in range(200):
         u, du, ddu = _row3(t, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
         if du == 0.0:
             break
-        if du > 0.0:
-            lo = t
-        else:
-            hi = t
-        delta = 0.5 * (xtol + RTOL * abs(t))
-        if hi - lo < 2.0 * delta:
+        tn, lo, hi, done = newton_step(t, du, ddu, lo, hi, xtol)
+        if done:
             break
-        if ddu < 0.0 and abs(du) < delta * -ddu:
-            break  # the next Newton step would be below the tolerance
-        tn = t - du / ddu if ddu < 0.0 else lo - 1.0
-        if not (lo < tn < hi):
-            tn = 0.5 * (lo + hi)
         t = tn
     return t, u
 

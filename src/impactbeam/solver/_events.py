@@ -44,7 +44,8 @@ from ._jit import njit
 from ._closed import EPS, clear_to_end, curvature_bound_at, derivatives, mode_state, particular
 from ._elementary import ROW_C, ROW_S, kernels_at
 
-__all__ = ["row_at", "row_from", "brent", "safe_step", "first_event", "scan", "departure"]
+__all__ = ["row_at", "row_from", "brent", "secant_start", "newton_step", "safe_step", "first_event", "scan",
+           "departure"]
 
 RTOL = 4.0 * EPS
 _STACK = 96
@@ -142,41 +143,60 @@ def brent(which, c, xa, xb, fa, fb, xtol, reg, a, w, om, VH, VD, base, PV, Om, p
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def secant_start(t0, t1, f0, f1):  # pragma: no cover - compiled
+    """Where the chord from ``(t0, f0)`` to ``(t1, f1)`` crosses zero (the midpoint if that is not inside)."""
+    t = t0 + (t1 - t0) * (f0 / (f0 - f1))
+    return t if t0 < t < t1 else 0.5 * (t0 + t1)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def newton_step(t, f, df, lo, hi, xtol):  # pragma: no cover - compiled
+    """One step of Newton's method for the root of a function that falls through zero in ``[lo, hi]``.
+
+    ``f, df``: its value (nonzero) and slope at ``t``, which becomes the
+    bracket's lower end if ``f > 0``, else its upper end. The step is kept
+    inside the bracket (bisection when it would leave it). Returns ``(next,
+    lo, hi, done)``: ``done`` when the step or the bracket is below
+    :func:`brent`'s tolerance ``(xtol + 4 eps |t|) / 2``, ``next`` then
+    being the last step (its error of the order of its square), or the
+    bracket's midpoint.
+    """
+    if f > 0.0:
+        lo = t
+    else:
+        hi = t
+    delta = 0.5 * (xtol + RTOL * abs(t))
+    tn = t - f / df if df < 0.0 else lo - 1.0
+    if lo <= tn <= hi and (abs(tn - t) < delta or hi - lo < 2.0 * delta):
+        return tn, lo, hi, True
+    if not (lo < tn < hi):
+        tn = 0.5 * (lo + hi)
+        if hi - lo < 2.0 * delta:
+            return tn, lo, hi, True
+    return tn, lo, hi, False
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def _crossing(c, t0, t1, g0, g1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cover
     """The root of ``h_c`` in ``[t0, t1]``, where it goes from ``g0 > 0`` to ``g1 <= 0``.
 
-    Newton's method with the slope that each evaluation (:func:`row_at`)
-    gives with the value, kept inside the bracket of the sign change
-    (bisection when a step would leave it), from the secant point. When the
-    next step or the bracket is below :func:`brent`'s tolerance ``(xtol + 4
-    eps |t|) / 2``, it returns that last step (its error is of the order of
-    its square: the crossings of the random systems of the test suite are
-    found to 3e-17 s, Brent's method stopped at up to 2e-14 s).
+    Newton's method (:func:`newton_step`) with the slope that each
+    evaluation (:func:`row_at`) gives with the value, from the secant point;
+    it returns the last step (the crossings of the random systems of the
+    test suite are found to 3e-17 s, Brent's method stopped at up to 2e-14 s).
     """
     if g1 == 0.0:
         return t1
     lo = t0
     hi = t1
-    t = t0 + (t1 - t0) * (g0 / (g0 - g1))
-    if not (lo < t < hi):
-        t = 0.5 * (lo + hi)
+    t = secant_start(t0, t1, g0, g1)
     for _ in range(200):
         g, dg = row_at(c, t, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
         if g == 0.0:
-            break
-        if g > 0.0:
-            lo = t
-        else:
-            hi = t
-        delta = 0.5 * (xtol + RTOL * abs(t))
-        tn = t - g / dg if dg < 0.0 else lo - 1.0
-        if lo <= tn <= hi and (abs(tn - t) < delta or hi - lo < 2.0 * delta):
-            return tn  # the last Newton step, below the tolerance: its error is of the order of its square
-        if not (lo < tn < hi):
-            tn = 0.5 * (lo + hi)
-            if hi - lo < 2.0 * delta:
-                return tn
-        t = tn
+            return t
+        t, lo, hi, done = newton_step(t, g, dg, lo, hi, xtol)
+        if done:
+            return t
     return t
 
 
