@@ -317,14 +317,8 @@ def _concave_peak(t0, t1, d0, d1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi
 @njit(cache=True, nogil=True, _nrt=False)
 def _push(stack, i, t0, u0, d0, c0, t1, u1, d1, c1):  # pragma: no cover - compiled
     """Row ``i`` of the branch-and-bound stack: an interval with value, slope and curvature at both ends."""
-    stack[i, 0] = t0
-    stack[i, 1] = u0
-    stack[i, 2] = d0
-    stack[i, 3] = c0
-    stack[i, 4] = t1
-    stack[i, 5] = u1
-    stack[i, 6] = d1
-    stack[i, 7] = c1
+    row = stack[i]
+    row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7] = t0, u0, d0, c0, t1, u1, d1, c1
 
 
 @njit(cache=True, nogil=True, _nrt=False)

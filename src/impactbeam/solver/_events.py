@@ -49,9 +49,8 @@ __all__ = ["row_at", "row_from", "brent", "secant_start", "newton_step", "safe_s
 
 RTOL = 4.0 * EPS
 _STACK = 96
-# what brent() solves for: passed as int64 values, not literal constants, so that numba compiles one
-# specialisation of brent, _f and row_at (a literal argument compiles a function once per value)
-VALUE = np.int64(0)
+# what brent() solves for (the roots of h_c' only since the crossings of h_c are refined by _crossing):
+# an int64 value, not a literal constant, so that numba compiles one specialisation of brent, _f and row_at
 SLOPE = np.int64(1)
 
 

@@ -222,8 +222,9 @@ def assemble(out, nev, top, t_top, low, energy_residual, deepest, n_rows, rc, ra
 def impact_forces(rc, ra, rbe, fpeaks, ints, d0, d1, n, side, gap, kst, dash):  # pragma: no cover - compiled
     """Peak force and impulse of contact intervals, in place of ``fpeaks`` and ``ints``.
 
-    The rule of :func:`impactbeam.result.metrics.contact_forces`. Row ``i`` of contactor ``c = rc[i]`` on ``[ra[i], rbe[i]]``: ``fpeaks[i]``,
-    the largest ``d + (c_d / k) d'`` (``d = s w - gap`` the compression),
+    The rule of :func:`impactbeam.result.metrics.contact_forces`. Row ``i``
+    of contactor ``c = rc[i]`` on ``[ra[i], rbe[i]]``: ``fpeaks[i]``, the
+    largest ``d + (c_d / k) d'`` (``d = s w - gap`` the compression),
     becomes the peak force ``k max(fpeaks[i], 0)``; ``ints[i] = int w dt``
     becomes the impulse ``k (s int w dt - gap (rbe - ra)) + c_d (d1 - d0)``,
     the dashpot's share from the compressions ``d0, d1`` at the ends (read

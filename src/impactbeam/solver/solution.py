@@ -342,7 +342,6 @@ class Solution(PiecewiseSolution):
         self.dashpots = packed.dash
         self._atol = 1e-12 * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
-        self._metric_rows: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         if event_arrays is None:  # times, kinds (1 impact, 0 rebound), contactors, velocities
             event_arrays = (np.array([e.time for e in events], dtype=float),
                             np.array([e.kind == "impact" for e in events], dtype=np.int64),
@@ -473,18 +472,16 @@ class Solution(PiecewiseSolution):
         return out, tuple(r[:n_rows] for r in rows)
 
     def metric_rows(self, x: float) -> tuple[np.ndarray, np.ndarray]:
-        """Shapes at ``x`` (S, n) and at each contactor (n_c, S, n) in every built state slot (cached per position,
-        here and by the packed problem for the runs that share it).
+        """Shapes at ``x`` (S, n) and at each contactor (n_c, S, n) in every built state slot.
+
+        Cached by the packed problem, for every run that shares it.
 
         Parameters
         ----------
         x : float, [m]
             The metric point.
         """
-        hit = self._metric_rows.get(x)
-        if hit is None:
-            hit = self._metric_rows[x] = self.packed.metric_rows(x, tuple(c.position for c in self.contactors))
-        return hit
+        return self.packed.metric_rows(x, tuple(c.position for c in self.contactors))
 
     def _row_table(self, xs: list[float]) -> tuple[np.ndarray, np.ndarray]:
         """Distinct positions of ``xs`` with their shapes in every visited state, and each x's row."""
