@@ -41,7 +41,7 @@ import math
 import numpy as np
 from ._jit import njit
 
-from ._closed import EPS, clear_to_end, curvature_bound_at, derivatives, mode_state, particular
+from ._closed import EPS, clear_to_end, curvature_bound_at, derivatives, kernels_into, mode_state, particular
 from ._elementary import ROW_C, ROW_S, kernels_at
 
 __all__ = ["row_at", "row_from", "brent", "secant_start", "newton_step", "safe_step", "first_event", "scan",
@@ -302,7 +302,7 @@ def first_event(c, ta, ga, dga, tb, gb, dgb, M, xtol, tol_h, stack, reg, a, w, o
 
 @njit(cache=True, nogil=True, _nrt=False)
 def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, stack, reg, a, w, om, VH, VD, base, PV,
-         Om, phi, work_h, work_d, kc, ks, kw):
+         Om, phi, work_h, work_d, kc, ks, ready, kw):
     # pragma: no cover - compiled
     """Advance from ``tau0`` to the first switching event before ``tau_end``.
 
@@ -312,17 +312,20 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
     segment's scan were taken before ``tau0`` (0 from the segment start;
     more when a scan stopped by its budget resumes, with ``g, dg, M`` as it
     left them, so that a resumed scan takes exactly the steps of one that was
-    never stopped). Returns ``(tau, c, n)``: the event time and row, ``c = -1``
-    if none up to ``tau_end``, or ``c = -2`` when ``budget`` more steps were
-    taken first (``tau`` is then the point reached, every row proven
-    consistent up to it); ``n`` the steps of the segment so far. ``kc, ks``:
-    the kernels at ``tau_end`` (:func:`~impactbeam.solver._closed.kernels_into`).
+    never stopped). Returns ``(tau, c, n, ready)``: the event time and row,
+    ``c = -1`` if none up to ``tau_end``, or ``c = -2`` when ``budget`` more
+    steps were taken first (``tau`` is then the point reached, every row
+    proven consistent up to it); ``n`` the steps of the segment so far;
+    whether ``kc, ks`` now hold the kernels at ``tau_end``
+    (:func:`~impactbeam.solver._closed.kernels_into`). They are computed here
+    when a step reaches ``tau_end`` unless ``ready`` on entry (a segment
+    ended by an event never needs them; equal lengths share them).
     """
     nc = g.size
     tau = tau0
     used = used0
     if clear_to_end(VH, VD, om, base, PV, tau_end):
-        return tau_end, -1, used
+        return tau_end, -1, used, ready
     while tau < tau_end:
         step = tau_end - tau
         for c in range(nc):
@@ -340,7 +343,10 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
         tb = tau + step
         if tb <= tau:
             tb = tau_end
-        if tb == tau_end:  # the kernels at the segment's end are given
+        if tb == tau_end:  # the kernels at the segment's end, once for every segment of this length
+            if not ready:
+                kernels_into(tau_end, reg, a, w, kc, ks, kw)
+                ready = True
             for c in range(nc):
                 gb[c], dgb[c] = row_from(c, tb, kc, ks, a, om, VH, VD, base, PV, Om, phi)
         else:  # the kernels once for every row
@@ -357,7 +363,7 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
                 best = r
                 which = c
         if which >= 0:
-            return best, which, used
+            return best, which, used, ready
         tau = tb
         for c in range(nc):
             g[c] = gb[c]
@@ -365,10 +371,10 @@ def scan(tau0, tau_end, g, dg, gb, dgb, M, dmin, xtol, tol_h, used0, budget, sta
         if used % 32 == 0:  # a decaying response earns longer steps
             curvature_bound_at(tau, VH, VD, reg, a, w, om, PV, Om, tau_end, M, work_h, work_d, kw)
             if clear_to_end(work_h, work_d, om, base, PV, tau_end):
-                return tau_end, -1, used
+                return tau_end, -1, used, ready
         if used - used0 >= budget and tau < tau_end:
-            return tau, -2, used
-    return tau_end, -1, used
+            return tau, -2, used, ready
+    return tau_end, -1, used, ready
 
 
 @njit(cache=True, nogil=True, _nrt=False)

@@ -407,13 +407,16 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
         for n in range(nm):
             wmax = max(wmax, om_s[n])
         dmin = math.pi / (4.0 * wmax) if wmax > 0.0 else tau_end
-        if s != k_slot or tau_end != k_tau:
+        ready = s == k_slot and tau_end == k_tau
+        tau_e, ch, used, ready = scan(tau0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h,
+                                      used0, budget - evals, stack, reg_s, dec_s, wdh_s, om_s, VH[:nr], VD[:nr],
+                                      base[:nr], PV[:nr], Om, phi, WH[:nr], WD[:nr], kc, ks, ready, kw)
+        if ch == -1 and not ready:  # the segment's end reached without a scan step there
             kernels_into(tau_end, reg_s, dec_s, wdh_s, kc, ks, kw)
+            ready = True
+        if ready:
             k_slot = s
             k_tau = tau_end
-        tau_e, ch, used = scan(tau0, tau_end, g[:nr], dg[:nr], gb[:nr], dgb[:nr], M[:nr], dmin, xtol, tol_h, used0,
-                               budget - evals, stack, reg_s, dec_s, wdh_s, om_s, VH[:nr], VD[:nr], base[:nr],
-                               PV[:nr], Om, phi, WH[:nr], WD[:nr], kc, ks, kw)
         evals += used - used0
         ic[I_EVALS] += used - used0
         if ch == -2:  # budget spent inside the segment: keep the scan's place and report
@@ -435,7 +438,7 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
             copy_into(seg_eta[i], eta)  # a view costs nothing here: no reference counting
             copy_into(seg_deta[i], deta)
             ic[I_NSEG] = i + 1
-            if ch == -1:  # te - t = tau_end: its kernels are at hand
+            if ch == -1:  # te - t = tau_end: its kernels are at hand (computed once for equal lengths)
                 state_from(tau_end, kc, ks, dec_s, om_s, h0, dh0, P, Om, phi, eta, deta)
             else:
                 state_at(te - t, reg_s, dec_s, wdh_s, om_s, h0, dh0, P, Om, phi, eta, deta, kw)
