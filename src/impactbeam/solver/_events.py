@@ -388,8 +388,15 @@ def departure(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL
     shape ``(2, dvec.size + 1)``.
     """
     kmax = dvec.size - 1
+    # the slope decides but at a tangency: the higher orders only then (the same sums either way)
+    derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, min(kmax, 1), dvec, mag,
+                work)
+    if kmax >= 1 and abs(dvec[1]) > 64.0 * EPS * mag[1]:
+        return 1 if dvec[1] > 0.0 else -1
+    if kmax <= 1:
+        return 0
     derivatives(v, u, base, a, om, eta0, deta0, load_A, load_B, load_D, load_E, AL, Om, phi, kmax, dvec, mag, work)
-    for k in range(1, kmax + 1):
+    for k in range(2, kmax + 1):
         if abs(dvec[k]) > 64.0 * EPS * mag[k]:
             return 1 if dvec[k] > 0.0 else -1
     return 0
