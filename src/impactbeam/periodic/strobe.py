@@ -445,22 +445,33 @@ def settle_and_record(scenario: Scenario, settle: int, record: int, start_state:
                       tolerance: float, max_period: int | None, limit: int) -> SteadyState:
     """Run, analyse, and extend the run while no period is found (see :func:`steady_state`).
 
+    :func:`settle_and_analyse`, with the extremes of the record searched.
+    """
+    return settle_and_analyse(scenario, settle, record, start_state, tolerance, max_period, limit).steady_state()
+
+
+def settle_and_analyse(scenario: Scenario, settle: int, record: int, start_state: ModalState | None,
+                       tolerance: float, max_period: int | None, limit: int) -> _RecordAnalysis:
+    """The record of :func:`settle_and_record` analysed, its extremes not yet searched (``.steady_state()`` does).
+
     When the beam provably never touches a stop from its start, the record is
     run from the linear steady state it tends to (:func:`~impactbeam.periodic.
     linear.linear_limit`): exact, with ``settled_after = 0``. With
     ``solver.modes = "auto"`` the first run chooses the count; an extension
     carries the modal state, so it runs with that count (:func:`with_modes_of`).
+    A bifurcation diagram searches the extremes of one value while the next
+    one runs.
     """
     steady = linear_limit(scenario, start_state)
     if steady is not None:
         res, t_load = run_periods(scenario, record, start_state=steady)
-        return _record_analysis(res, scenario, 0, record, tolerance, max_period, t_load, 0).steady_state()
+        return _record_analysis(res, scenario, 0, record, tolerance, max_period, t_load, 0)
     res, t_load = run_periods(scenario, settle + record, start_state=start_state)
     scenario = with_modes_of(scenario, res)
     done = settle
     while True:
         rec = _record_analysis(res, scenario, settle, record, tolerance, max_period, t_load, done)
         if rec.period or res.status != 0 or done + settle + record > limit:
-            return rec.steady_state()
+            return rec
         res, t_load = run_periods(scenario, settle + record, start_state=res.final_state())
         done += settle + record

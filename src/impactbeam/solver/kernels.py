@@ -36,6 +36,7 @@ import logging
 import os
 import subprocess
 import sys
+import threading
 import time
 import types
 from contextlib import contextmanager
@@ -75,6 +76,9 @@ _CHECKED = -1e9  # when the cache was last looked at
 _SPENT = 0.0  # seconds spent in the interpreted kernels' entry points
 _SPAWNED = False
 _FORCED: str | None = None
+# choosing and loading the kernels changes the state above: one thread at a time (a bifurcation diagram searches
+# the extremes of its records on a second thread while the next value runs)
+_LOCK = threading.RLock()
 
 
 def compiled() -> Kernels:
@@ -89,12 +93,13 @@ def compiled() -> Kernels:
     loaded, and numba compiles them afresh.
     """
     global _COMPILED
-    if _COMPILED is None:
-        ns = _namespace(_PACKAGE, False)
-        if not _digest_matches(ns) and not warmup_running(ns):
-            purge_cache(ns)
-        _COMPILED = ns
-    return _COMPILED
+    with _LOCK:
+        if _COMPILED is None:
+            ns = _namespace(_PACKAGE, False)
+            if not _digest_matches(ns) and not warmup_running(ns):
+                purge_cache(ns)
+            _COMPILED = ns
+        return _COMPILED
 
 
 def source_digest() -> str:
@@ -168,6 +173,11 @@ def interpreted() -> Kernels:
     :data:`_SPENT`, from which :func:`for_work` judges when a process has run
     enough small work to be better off with the compiled kernels.
     """
+    with _LOCK:
+        return _interpreted()
+
+
+def _interpreted() -> Kernels:
     global _INTERPRETED
     if _INTERPRETED is None:
         if _TWIN not in sys.modules:
@@ -236,14 +246,15 @@ def active() -> Kernels:
         return compiled() if _FORCED == "compiled" else interpreted()
     if _LOADED:
         return compiled()
-    now = time.monotonic()
-    if _READY or now - _CHECKED >= 1.0:
-        _CHECKED = now
-        if ready():
-            _LOADED = True
-            return compiled()
-        _compile_in_background()
-    return interpreted()
+    with _LOCK:
+        now = time.monotonic()
+        if _LOADED or _READY or now - _CHECKED >= 1.0:
+            _CHECKED = now
+            if _LOADED or ready():
+                _LOADED = True
+                return compiled()
+            _compile_in_background()
+        return interpreted()
 
 
 def for_work(size: int) -> Kernels:
@@ -272,10 +283,12 @@ def batched() -> Kernels:
     global _LOADED
     if _FORCED == "interpreted":
         return interpreted()
-    if _FORCED is None and not _LOADED and not ready():
-        _LOG.warning("impactbeam: compiling the solver for this machine (first use only; up to a minute on 2 cores)")
-    _LOADED = True
-    return compiled()
+    with _LOCK:
+        if _FORCED is None and not _LOADED and not ready():
+            _LOG.warning("impactbeam: compiling the solver for this machine (first use only; up to a minute on 2 "
+                         "cores)")
+        _LOADED = True
+        return compiled()
 
 
 #: Seconds of interpreted kernels after which a process asks for the compiled ones (a loop of short runs).
