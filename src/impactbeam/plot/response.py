@@ -30,14 +30,11 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from .figure import PlotHandles, _finish, _new_figure, save_figure
+from .figure import PlotHandles, _finish, _new_figure
 from .style import (
     _EXCITATION_AXIS,
-    SERIES_STYLES,
-    STYLE,
     _outside_legend,
     _response_label,
-    rc_context,
     surface_w,
     _side_legend,
     _style,

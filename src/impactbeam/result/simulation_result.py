@@ -5,13 +5,12 @@ from __future__ import annotations
 import functools
 import os
 from dataclasses import dataclass, field
-from pathlib import Path
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._memory import check_memory, check_output_size, memory_limit, output_bytes, sample_count
+from .._memory import check_output_size, sample_count
 from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
 

@@ -68,7 +68,7 @@ from ._events import departure, scan
 from ._codes import (  # noqa: E402 - status codes and the carry's layout, shared with the Python side
     CHATTER, CHECKPOINT, DONE, F_LAST_T, F_T, F_TAU, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T, I_EVALS, I_JUST, I_NEV,
     I_NJUMP, I_NSEG, I_NSLOTS, I_NTR, I_PENDING, I_PIECE, I_RESUME, I_SAME, I_SLOT, I_USED, I_WARN_C, I_WARN_N,
-    MOVED_FLOOR, MOVED_WARN, N_FLOAT, N_INT, NEED_SPACE, NEED_STATE, NEED_TRANSFER, REQ_A, REQ_B,
+    MOVED_FLOOR, MOVED_WARN, NEED_SPACE, NEED_STATE, NEED_TRANSFER, REQ_A, REQ_B,
 )
 
 KMAX = 5  # highest derivative used to judge a tangency

@@ -151,7 +151,6 @@ def state_damping_matrix(damping: Damping, engaged: Sequence[int], omega: np.nda
     C : ndarray, (n, n), [1/s]
     diagonal : bool
     """
-    n = omega.size
     if damping.model == "free_modes" and engaged:
         D = 2.0 * damping.ratios(False, free_omega.size) * free_omega
         C = (free_overlap * D) @ free_overlap.T
