@@ -293,8 +293,10 @@ def bifurcation(
                     scenarios = {u: with_modes_of(s, res) for u, s in scenarios.items()}
                 for w in rec.warnings:
                     warns.append(f"{parameter} = {v:.6g} ({direction}): {w}")
-                searched.append((v, direction, extremes.submit(rec.steady_state)))
                 state = res.final_state() if res.status == 0 else None
+                # submitted after the final state: the search's Python then runs while the next value's loop
+                # (compiled, without the interpreter lock) does, not while this thread waits for the lock
+                searched.append((v, direction, extremes.submit(rec.steady_state)))
                 if state is None and not from_rest and i + 1 < len(plan):
                     warns.append(f"{parameter} = {v:.6g} ({direction}): the run stopped early, so the next value "
                                  "starts from rest")
