@@ -93,6 +93,8 @@ def compiled() -> Kernels:
     loaded, and numba compiles them afresh.
     """
     global _COMPILED
+    if _COMPILED is not None:  # loaded: no lock needed to read it
+        return _COMPILED
     with _LOCK:
         if _COMPILED is None:
             ns = _namespace(_PACKAGE, False)
@@ -173,6 +175,8 @@ def interpreted() -> Kernels:
     :data:`_SPENT`, from which :func:`for_work` judges when a process has run
     enough small work to be better off with the compiled kernels.
     """
+    if _INTERPRETED is not None:
+        return _INTERPRETED
     with _LOCK:
         return _interpreted()
 
