@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -236,3 +237,28 @@ def test_up_and_down_sweeps_find_coexisting_orbits(scenario_file):
         np.testing.assert_allclose(again.strobe, s.strobe, rtol=0, atol=1e-7 * s.max)
     # two different orbits: their Poincare points are far apart (1.0e-4 m and -0.8e-4 m)
     assert abs(at["up"].strobe[0] - at["down"].strobe[0]) > 0.5 * at["up"].max
+
+
+def test_each_point_is_the_single_run_from_the_previous_state(scenario_file):
+    """The diagram's extremes are searched on a second thread while the next value runs: every point is still,
+    to the bit, what one steady-state run from the previous point's final state gives (strobe, period,
+    extremes, extensions), impacting and free values, up and down."""
+    sc = ib.load_scenario(scenario_file)
+    values = [31.0, 32.5, 45.0, 57.0, 100.0]
+    with pytest.warns(ib.ImpactBeamWarning):  # some values do not settle in 30 periods: said so, also below
+        d = bifurcation(sc, "excitation.frequency", values, sweep="both", settle_periods=30, record_periods=10)
+    assert len(d.points) == 2 * len(values)
+    state = None
+    for p in d.points:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ib.ImpactBeamWarning)
+            one = steady_state(sc.with_values({"excitation.frequency": p.value}), settle_periods=30,
+                               record_periods=10, start_state=state)
+        s = p.state
+        assert (s.period, s.settled_after, s.impacts_per_period) == (one.period, one.settled_after,
+                                                                      one.impacts_per_period)
+        np.testing.assert_array_equal(s.strobe, one.strobe)
+        assert (s.max, s.min) == (one.max, one.min)
+        state = one.result.final_state()
+    assert any(p.state.impacts_per_period > 0 for p in d.points)
+    assert any(p.state.settled_after == 0 for p in d.points)  # a value run from its linear steady state

@@ -20,7 +20,6 @@ continuation, whose next case starts from this one's final state).
 
 from __future__ import annotations
 
-
 from ._closed import copy_into
 from ._codes import CASE_DONE
 from ._dense import dense_work
