@@ -24,10 +24,16 @@ every regime, with ``z1 = z0' - alpha``. Rigid-body modes that the damping
 does not touch stay modes of their own (the pair ``(eta, eta')`` with
 ``M = [[0, 1], [0, 0]]``). The maps ``x = G (z, z' - alpha)`` and back
 ``H`` are exact linear algebra; nothing is approximated beyond round-off,
-which :func:`slot_arrays` measures (``residual``) and refuses above 1e-8.
+which :func:`slot_arrays` measures (``residual`` of the subspaces, the
+inverse map, and the blocks' evolution against ``expm``,
+:func:`exponential_error`) and refuses beyond it with a clear message.
 
-A cluster of more than two eigenvalues within 1e-10 of each other (which
-would make the blocks ill-conditioned) is refused with a clear message.
+Real eigenvalues are paired so that no block is nearly a multiple of the
+identity (:func:`_pairs`): stiffness-proportional damping (Rayleigh
+``beta``) puts the slow rates of all over-damped modes near ``1/beta``,
+and two of them in one block have singular companion coordinates. When
+more than half the real rates of a state crowd together, two must share a
+block: that state is refused.
 """
 
 from __future__ import annotations
@@ -38,9 +44,11 @@ import numpy as np
 
 from ..exceptions import SimulationError
 
-__all__ = ["SlotArrays", "slot_arrays", "classical_slot", "block_structure"]
+__all__ = ["SlotArrays", "slot_arrays", "classical_slot", "block_structure", "exponential_error"]
 
-_CLUSTER = 1e-10  # relative distance under which eigenvalues belong to one block
+_CLUSTER = 1e-10  # relative size of an imaginary part under which an eigenvalue is real
+_PARALLEL = 0.1  # sine of the angle under which two real eigenvectors are taken as one nearly defective pair
+_APART = 0.1  # relative difference of magnitude from which two real eigenvalues may share a block
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,30 +116,70 @@ def classical_slot(omega: np.ndarray, decay: np.ndarray, Wc: np.ndarray, pw: np.
                       np.zeros((2, 2 * n, n)), np.zeros((2, n, 2 * n)), np.zeros((n, n)))
 
 
-def _pairs(lam: np.ndarray, scale: float) -> list[tuple[int, int]]:
-    """Indices of the eigenvalues taken two by two: conjugate pairs, and real ones with their nearest."""
-    order = np.lexsort((np.abs(lam.imag), lam.real))
+def _pairs(lam: np.ndarray, vec: np.ndarray, scale: float) -> list[tuple[int, int]]:
+    """Indices of the eigenvalues taken two by two: conjugate pairs, then the real ones.
+
+    Two real eigenvalues whose eigenvectors are nearly parallel (``sin`` of
+    their angle below :data:`_PARALLEL`: a nearly defective pair, near
+    critical damping) share a block, the largest cosine first. Each other
+    real one goes with its nearest whose magnitude differs by :data:`_APART`
+    or more, the one with the fewest such partners first (ties in order of
+    the real part). Two nearly equal rates with independent eigenvectors
+    would make a block that is nearly a multiple of the identity, whose
+    companion coordinates are singular: stiffness-proportional damping
+    (Rayleigh ``beta``) crowds the slow rates of every over-damped mode near
+    ``1/beta``, mass-proportional damping the fast ones near ``alpha``. A
+    rate with no such partner left takes its nearest (the checks of
+    :func:`slot_arrays` then judge the blocks).
+    """
+    complex_ = np.abs(lam.imag) > _CLUSTER * scale
     used = np.zeros(lam.size, dtype=bool)
     out = []
+    order = np.lexsort((np.abs(lam.imag), lam.real))
     for i in order:
-        if used[i]:
+        if used[i] or not complex_[i]:
             continue
         used[i] = True
-        cand = np.where(used, np.inf, np.abs(lam - (np.conj(lam[i]) if abs(lam[i].imag) > _CLUSTER * scale else lam[i])))
-        if abs(lam[i].imag) <= _CLUSTER * scale:
-            cand = np.where(np.abs(lam.imag) > _CLUSTER * scale, np.inf, cand)
+        cand = np.where(used | ~complex_, np.inf, np.abs(lam - np.conj(lam[i])))
         j = int(np.argmin(cand))
         if not np.isfinite(cand[j]):
             raise SimulationError("non-proportional damping: an eigenvalue of a state has no partner")
         used[j] = True
         out.append((int(i), j))
-    for i, j in out:
-        near = (np.abs(lam - lam[i]) <= _CLUSTER * scale) | (np.abs(lam - lam[j]) <= _CLUSTER * scale)
-        if np.count_nonzero(near) > 2:
-            raise SimulationError(
-                "non-proportional damping: more than two eigenvalues of a state coincide (a cluster at "
-                f"{lam[i]:.6g}); the block decomposition needs them in pairs. Change a damping value slightly."
-            )
+    real = np.array([i for i in order if not used[i]], dtype=np.int64)
+    if real.size % 2:
+        raise SimulationError("non-proportional damping: an eigenvalue of a state has no partner")
+    U = vec[:, real].real
+    U = U / np.maximum(np.linalg.norm(U, axis=0), 1e-300)
+    cos2 = (U.T @ U) ** 2
+    parallel = cos2 >= 1.0 - _PARALLEL**2
+    r = lam[real].real
+    distance = np.abs(r[:, None] - r[None, :])
+    apart = distance >= _APART * np.maximum(np.abs(r[:, None]), np.abs(r[None, :]))
+    np.fill_diagonal(distance, np.inf)
+    np.fill_diagonal(cos2, -1.0)
+    left = np.ones(real.size, dtype=bool)
+
+    def take(a: int, b: int) -> None:
+        out.append((int(real[a]), int(real[b])))
+        left[[a, b]] = False
+        cos2[[a, b], :] = -1.0
+        cos2[:, [a, b]] = -1.0
+
+    while real.size:
+        a, b = np.unravel_index(int(np.argmax(cos2)), cos2.shape)
+        if cos2[a, b] < 1.0 - _PARALLEL**2:
+            break
+        take(int(a), int(b))
+    while left.any():
+        ok = (apart | parallel) & left[None, :] & left[:, None]
+        np.fill_diagonal(ok, False)
+        counts = np.where(left, ok.sum(axis=1), real.size + 1)
+        a = int(np.argmin(counts))
+        cand = np.where(left, np.where(ok[a], distance[a], np.inf), np.inf)
+        if not np.isfinite(cand).any():
+            cand = np.where(left, distance[a], np.inf)
+        take(a, int(np.argmin(cand)))
     return out
 
 
@@ -148,7 +196,7 @@ def _invariant_pairs(At: np.ndarray) -> list[np.ndarray]:
     scale = max(float(np.max(np.abs(lam))), 1.0)
     I = np.eye(At.shape[0])
     out = []
-    for i, j in _pairs(lam, scale):
+    for i, j in _pairs(lam, vec, scale):
         if abs(lam[i].imag) > _CLUSTER * scale:
             Y = np.column_stack([vec[:, i].real, vec[:, i].imag])
         else:
@@ -205,7 +253,12 @@ def block_structure(omega: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 def _companion(M: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """``S`` with ``S^-1 M S = [[0, 1], [-omega^2, -2a]]`` (best conditioned of a few ``e``), and ``a``, ``omega^2``."""
+    """``S`` with ``S^-1 M S = [[0, 1], [-omega^2, -2a]]`` (best conditioned of a few ``e``), and ``a``, ``omega^2``.
+
+    The condition is that of ``S`` with unit columns: the first column is of
+    the size of the block's rates, the second of one, and a column's size is
+    the scale of a coordinate, which no result depends on.
+    """
     a = -0.5 * float(np.trace(M))
     w2 = float(np.linalg.det(M))
     N = M + 2.0 * a * np.eye(2)
@@ -213,7 +266,7 @@ def _companion(M: np.ndarray) -> tuple[np.ndarray, float, float]:
     for e in (np.array([1.0, 0.0]), np.array([0.0, 1.0]), np.array([1.0, 1.0]) / np.sqrt(2.0),
               np.array([1.0, -1.0]) / np.sqrt(2.0)):
         S = np.column_stack([N @ e, e])
-        cond = np.linalg.cond(S)
+        cond = np.linalg.cond(S / np.maximum(np.linalg.norm(S, axis=0), 1e-300))  # the columns' sizes do not matter
         if cond < best_cond:
             best, best_cond = S, cond
     if best is None or not np.isfinite(best_cond) or best_cond > 1e10:
@@ -222,6 +275,56 @@ def _companion(M: np.ndarray) -> tuple[np.ndarray, float, float]:
             "with two independent modes); change a damping value slightly"
         )
     return best, a, max(w2, 0.0)
+
+
+def exponential_error(As: np.ndarray, Gs: np.ndarray, Hs: np.ndarray, dec: np.ndarray, om: np.ndarray) -> float:
+    """How far the blocks' own evolution departs from ``expm(As t)``, relative to the state's size.
+
+    Each block's companion matrix ``[[0, 1], [-omega^2, -2a]]`` advanced by
+    its 2 x 2 exponential and mapped by ``Gs`` (its inverse ``Hs``), against
+    scipy's ``expm`` of the whole scaled matrix ``As``, from a fixed random
+    state, at the times ``1 / r`` of the slowest and fastest nonzero rates
+    ``r`` of the blocks and their geometric mean: an error in a block's
+    rates or subspace shows where that block's motion does.
+
+    Parameters
+    ----------
+    As : ndarray, (2n, 2n)
+        The state's first-order matrix in the scaled coordinates (:func:`block_structure`).
+    Gs, Hs : ndarray, (2n, 2n)
+        The map from the blocks' coordinates ``(z0, z1)`` (all ``z0`` first) to
+        the scaled coordinates, and its inverse.
+    dec, om : ndarray, (n,)
+        Each block's ``a`` and ``omega``.
+
+    Returns
+    -------
+    float
+        The largest difference, relative to the largest component of the exact state.
+    """
+    from scipy.linalg import expm
+
+    n = dec.size
+    w2 = om**2
+    fast = np.abs(dec) + np.sqrt(np.abs(dec**2 - w2))
+    rates = np.concatenate([fast, w2 / np.maximum(fast, 1e-300)])
+    rates = rates[rates > 1e-300]
+    if not rates.size:
+        return 0.0
+    lo, hi = float(rates.min()), float(rates.max())
+    x0 = np.random.default_rng(0).standard_normal(2 * n)
+    z0 = Hs @ x0
+    companion = np.zeros((n, 2, 2))
+    companion[:, 0, 1] = 1.0
+    companion[:, 1, 0] = -w2
+    companion[:, 1, 1] = -2.0 * dec
+    worst = 0.0
+    for t in (1.0 / hi, 1.0 / np.sqrt(lo * hi), 1.0 / lo):
+        zt = np.einsum("kij,kj->ki", expm(t * companion), np.column_stack([z0[:n], z0[n:]]))
+        z = np.concatenate([zt[:, 0], zt[:, 1]])
+        exact = expm(t * As) @ x0
+        worst = max(worst, float(np.max(np.abs(Gs @ z - exact))) / max(float(np.max(np.abs(exact))), 1e-300))
+    return worst
 
 
 def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray, pre: np.ndarray) -> SlotArrays:
@@ -251,29 +354,38 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
             f"non-proportional damping: the state's block decomposition is not accurate ({residual:.2g}); "
             "this damping cannot be integrated exactly"
         )
-    Gm = np.zeros((2 * n, 2 * n))  # columns (z0_k, z1_k) interleaved by block
+    Gs = np.zeros((2 * n, 2 * n))  # the map in the scaled coordinates, columns (z0_k, z1_k) interleaved by block
     reg = np.zeros(n, dtype=np.int64)
     dec = np.zeros(n)
     om = np.zeros(n)
     unscale = np.concatenate([1.0 / dscale, np.ones(n)])  # xs -> x
-    # round-off floors, as the states' own rigid-body threshold (eigenvalues below 1e-13 of the largest):
-    # a rigid-body block gets exact polynomials, not A / omega^2 against its homogeneous part
+    # round-off floors: a block's entries carry errors of about the round-off of the largest rate (the
+    # eigenvectors are of the whole matrix), so a decay rate below 1e-13 of it and an omega^2 below 1e-13 of it
+    # times the block's size are zero: a rigid-body block gets exact polynomials, not A / omega^2 against its
+    # homogeneous part. (Against the largest rate squared, the floor zeroed the omega^2 = r1 r2 of a block
+    # pairing a slow rate with a moderate one when the damping's largest rate is 1e7 times larger.)
     rate = max(float(np.max(omega)), float(np.max(np.abs(C))), 1e-300)
     for k, Y in enumerate(blocks):
         M = Y.T @ As @ Y
         S, a, w2 = _companion(M)
-        if w2 < 1e-13 * rate**2:
+        if w2 < 1e-13 * rate * float(np.max(np.abs(M))):
             w2 = 0.0
         if abs(a) < 1e-13 * rate:
             a = 0.0
-        GS = unscale[:, None] * (Y @ S)
-        Gm[:, k] = GS[:, 0]
-        Gm[:, n + k] = GS[:, 1]
+        YS = Y @ S
+        Gs[:, k] = YS[:, 0]
+        Gs[:, n + k] = YS[:, 1]
         dec[k] = a
         om[k] = np.sqrt(w2)
     reg, wdh = _regimes(om, dec)
-    Hm = np.linalg.inv(Gm)
-    miss = float(np.linalg.norm(Hm @ Gm - np.eye(2 * n), np.inf))
+    # inverted with unit columns in the scaled coordinates: a block's two columns differ in size by its rates,
+    # and the coordinates (d eta, eta') by d, which neither the accuracy of the map nor its inverse depends on
+    norms = np.linalg.norm(Gs, axis=0)
+    Gn = Gs / norms
+    Hn = np.linalg.inv(Gn)
+    miss = float(np.linalg.norm(Hn @ Gn - np.eye(2 * n), np.inf))
+    Gm = unscale[:, None] * Gs
+    Hm = Hn / norms[:, None] / unscale[None, :]
     if miss > 1e-6:
         near = _clustered(np.linalg.eigvals(As))
         why = (f"{near} of its {2 * n} eigenvalues lie within 1 % of another; stiffness-proportional damping of "
@@ -283,6 +395,12 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
         raise SimulationError(
             f"non-proportional damping: the state's coordinates are too ill-conditioned to integrate exactly ({why}, "
             'or run method = "ivp"'
+        )
+    error = exponential_error(As, Gs, Hn / norms[:, None], dec, om)
+    if error > 1e-6:
+        raise SimulationError(
+            "non-proportional damping: the state's block coordinates reproduce its matrix exponential only to "
+            f"{error:.1g}; lower that damping or the mode count, or run method = \"ivp\""
         )
     G = np.stack([Gm[:, :n], Gm[:, n:]])
     H = np.stack([Hm[:n], Hm[n:]])
