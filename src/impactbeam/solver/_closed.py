@@ -51,7 +51,7 @@ from ._elementary import REG_CRITICAL, REG_OVER, REG_UNDER, ROW_C, ROW_S, kernel
 from ._jit import njit
 
 __all__ = ["REG_UNDER", "REG_CRITICAL", "REG_OVER", "NP", "sincos", "kernel", "setup", "segment_setup", "state_at",
-           "mode_state", "kernels_into", "state_from",
+           "mode_state", "kernels_into", "state_from", "load_phase", "particular_at",
            "project", "integral_of", "derivatives", "curvature_bound", "particular_spread",
            "clear_to_end", "jerk_bound", "workspace",
            "copy_into",
@@ -64,11 +64,28 @@ NP = 8  # coefficients of a particular part
 @njit(cache=True, nogil=True, _nrt=False)
 def particular(p, tau, Om, phi):  # pragma: no cover - compiled
     """Particular part and its derivative from the eight coefficients ``p``."""
+    s, c = load_phase(tau, Om, phi)
+    return particular_at(p, tau, Om, s, c)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def load_phase(tau, Om, phi):  # pragma: no cover - compiled
+    """``(sin, cos)`` of the harmonic load's phase ``Om tau + phi`` (zeros without a harmonic part).
+
+    Every coordinate of a state shares it: computed once per time and passed
+    to :func:`particular_at`, the same numbers as :func:`particular`.
+    """
+    if Om != 0.0:
+        return sincos(Om * tau + phi)
+    return 0.0, 0.0
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def particular_at(p, tau, Om, s, c):  # pragma: no cover - compiled
+    """:func:`particular` with the load's phase given as ``s, c`` (:func:`load_phase`)."""
     val = p[0] + tau * (p[1] + tau * (p[2] + tau * p[3]))
     der = p[1] + tau * (2.0 * p[2] + 3.0 * p[3] * tau)
     if Om != 0.0:
-        th = Om * tau + phi
-        s, c = sincos(th)
         val += p[4] * s + p[5] * c + tau * (p[6] * c + p[7] * s)
         der += Om * (p[4] * c - p[5] * s) + p[6] * (c - Om * tau * s) + p[7] * (s + Om * tau * c)
     return val, der
@@ -96,6 +113,7 @@ def setup(reg, a, om, load_A, load_B, load_D, load_E, Om, phi, eta0, deta0, h0, 
         Filled: homogeneous initial values and particular coefficients.
     """
     W2 = Om * Om
+    sn, cs = load_phase(0.0, Om, phi)
     for n in range(om.size):
         A = load_A[n]
         B = load_B[n]
@@ -129,7 +147,7 @@ def setup(reg, a, om, load_A, load_B, load_D, load_E, Om, phi, eta0, deta0, h0, 
                 else:  # Im and Re of (D - i E)... : the response to exp(i theta) is 1 / (re + i im)
                     P[n, 4] = (D * re + E * im) / den
                     P[n, 5] = (E * re - D * im) / den
-        p0, dp0 = particular(P[n], 0.0, Om, phi)
+        p0, dp0 = particular_at(P[n], 0.0, Om, sn, cs)
         h0[n] = eta0[n] - p0
         dh0[n] = deta0[n] - dp0
 
@@ -159,8 +177,9 @@ def kernels_into(tau, reg, a, w, kc, ks, kw):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, _nrt=False)
 def state_from(tau, kc, ks, a, om, h0, dh0, P, Om, phi, e, d):  # pragma: no cover - compiled
     """:func:`state_at` with the kernels at ``tau`` given (:func:`kernels_into`): the same numbers."""
+    sn, cs = load_phase(tau, Om, phi)
     for n in range(om.size):
-        pv, pd = particular(P[n], tau, Om, phi)
+        pv, pd = particular_at(P[n], tau, Om, sn, cs)
         zh, dzh = mode_state(kc[n], ks[n], a[n], om[n], h0[n], dh0[n])
         e[n] = zh + pv
         d[n] = dzh + pd

@@ -35,8 +35,8 @@ import numpy as np
 from ._jit import njit
 
 from ._closed import (
-    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, particular, particular_spread, project,
-    segment_setup, sincos, state_at, workspace,
+    NP, alpha_at, copy_into, curvature_bound, integral_of, jerk_bound, load_phase, particular_at, particular_spread,
+    project, segment_setup, state_at, workspace,
 )
 from ._elementary import ROW_C, ROW_S, kernel_work, kernels_at
 from ._events import newton_step, secant_start
@@ -265,11 +265,10 @@ def _row3(tau, reg, a, w, om, VH, VD, base, PV, Om, phi, kw):  # pragma: no cove
     ``kw``: the scratch of :func:`~impactbeam.solver._elementary.kernels_at`.
     """
     p = PV[0]
-    u, du = particular(p, tau, Om, phi)
+    sn, cs = load_phase(tau, Om, phi)
+    u, du = particular_at(p, tau, Om, sn, cs)
     ddu = 2.0 * p[2] + 6.0 * p[3] * tau
     if Om != 0.0:
-        th = Om * tau + phi
-        sn, cs = sincos(th)
         ddu += -Om * Om * (p[4] * sn + p[5] * cs) + p[6] * (-2.0 * Om * sn - Om * Om * tau * cs)
         ddu += p[7] * (2.0 * Om * cs - Om * Om * tau * sn)
     u += base[0]

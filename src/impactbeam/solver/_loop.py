@@ -59,8 +59,8 @@ import numpy as np
 from ._jit import njit
 
 from ._closed import (
-    NP, alpha_at, copy_into, curvature_bound, kernels_into, particular, project, segment_setup, state_at, state_from,
-    workspace,
+    NP, alpha_at, copy_into, curvature_bound, kernels_into, load_phase, particular_at, project, segment_setup, state_at,
+    state_from, workspace,
 )
 from ._elementary import kernel_work
 from ._events import departure, scan
@@ -291,8 +291,9 @@ def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD
 def _openings(PV, VH, VD, base, nr, Om, phi, tol_h, g, dg):  # pragma: no cover - compiled
     """The first ``nr`` rows' values ``g`` and slopes ``dg`` at the segment start; True if one is within ``tol_h``."""
     touching = False
+    sn, cs = load_phase(0.0, Om, phi)
     for r in range(nr):
-        pv, pd = particular(PV[r], 0.0, Om, phi)
+        pv, pd = particular_at(PV[r], 0.0, Om, sn, cs)
         g[r] = base[r] + pv
         dg[r] = pd
         for n in range(VH.shape[1]):
