@@ -134,6 +134,44 @@ def test_random_system_exact_and_ivp_agree(seed):
     assert np.max(np.abs(w_ex - w_iv)) <= R_HISTORY * np.max(np.abs(w_iv))
 
 
+def rayleigh_dashpot_system(seed: int) -> dict:
+    """:func:`random_system` with Rayleigh damping (``beta`` 3e-5 to 3e-4 s), a dashpot at every stop, 12-24 modes.
+
+    The over-damped high coordinates then crowd their slow rates near
+    ``1/beta`` in every engaged state (solver/blocks.py pairs them apart);
+    zero gaps become 1e-5 m (the grazes of a zero gap part the two paths
+    by the engine's touch tolerance, module docstring), restitution is
+    dropped (a dashpot is given), and the run is 10 ms (solve_ivp integrates
+    the fast rates, up to 1e9/s, with steps that small).
+    """
+    rng = random.Random(1000 + seed)
+    d = random_system(seed)
+    d["damping"] = {"model": "rayleigh", "alpha": rng.choice([0.0, 5.0]), "beta": rng.choice([3e-5, 1e-4, 3e-4])}
+    for c in d["contactors"]:
+        c.pop("restitution", None)
+        c["damping"] = rng.choice([0.05, 0.5, 2.0])
+        if c["gap"] == 0.0:
+            c["gap"] = 1e-5
+    d["solver"].update(modes=rng.choice([12, 16, 24]), end_time=0.01)
+    return d
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [7, 9, 12, 14, 17])
+def test_rayleigh_beta_with_dashpots_exact_and_ivp_agree(seed):
+    # Seeds 7 and 17 were refused before the blocks paired real rates 10 % apart (17 of the first 40 draws
+    # were; all 40 run now, and the first 19 have the same events as solve_ivp, times within 1.7e-12 s); 9, 12
+    # and 14 ran before too. Same tolerances as above (test_engine.compare). Left out: draws that part where
+    # the rules allow it, a maximum so flat that its time is not defined to 1e-10 s (seed 6: 4e-9 s apart, the
+    # values 1.7e-10 apart) and responses so small (3.5e-8 m, 8.5e-11 m: seeds 5 and 11) that the extremes'
+    # absolute tolerance is more than 1e-7 of them.
+    sc = ib.parse_scenario(rayleigh_dashpot_system(seed))
+    args = problem(beam=sc.beam, contactors=sc.contactors, damping=sc.damping, excitation=sc.excitation,
+                   initial=sc.initial, options=sc.solver, points=[c.position for c in sc.contactors] + [sc.beam.length],
+                   preload=sc.preload)
+    compare(args)
+
+
 def test_ivp_extremum_survives_a_round_off_slope_at_a_grid_point():
     # Seed 48 at 128 modes (the count solver.modes = "auto" reached for it): a contact's deepest compression lies
     # at a segment's end, where the dense output's slope is 1.7e-18 on the search grid and -1.7e-18 at the single
