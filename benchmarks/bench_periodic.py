@@ -73,7 +73,8 @@ class SweepClock(KernelClock):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=400, help="forcing frequencies (each swept up and down)")
-    ap.add_argument("--baseline-points", type=int, default=3, help="points run by the solve_ivp baseline")
+    ap.add_argument("--baseline-points", type=int, default=3,
+                    help="points run by the solve_ivp baseline (0: the sweep alone)")
     ap.add_argument("--breakdown", action="store_true", help="time the compiled kernels inside the sweep too")
     args = ap.parse_args()
     warnings.simplefilter("ignore", ib.ImpactBeamWarning)  # counted below instead
@@ -107,6 +108,8 @@ def main() -> None:
         clock.report(t_again, sum(p.state.settled_after + RECORD for p in again.diagram.points),
                      len(again.diagram.points) * (SETTLE + RECORD))
 
+    if args.baseline_points < 1:  # the sweep alone (its time, its breakdown)
+        return
     picks = freqs[np.linspace(0, freqs.size - 1, args.baseline_points + 2).astype(int)[1:-1]]
     t_ivp = t_exact = 0.0
     worst = 0.0
