@@ -207,7 +207,7 @@ def test_the_blocks_check_against_expm_sees_a_wrong_rate():
     # solver.blocks.exponential_error, the check every state with non-proportional damping passes before it is
     # used: its blocks' own evolution against scipy's expm of the state's matrix. On a correct decomposition it
     # measures round-off (1.1e-13 here); one block's omega off by 1e-3 is seen at 1.5e-3 (a slow rate of a
-    # Rayleigh cluster lost to a round-off floor was off by 100 %, seen at 0.2 to 30).
+    # Rayleigh cluster lost to a round-off floor was off by 100 %, seen at 0.2 to 1.9).
     from impactbeam.solver.blocks import exponential_error, slot_arrays
 
     rng = np.random.default_rng(7)
