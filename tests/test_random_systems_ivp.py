@@ -142,7 +142,8 @@ def rayleigh_dashpot_system(seed: int) -> dict:
     zero gaps become 1e-5 m (the grazes of a zero gap part the two paths
     by the engine's touch tolerance, module docstring), restitution is
     dropped (a dashpot is given), and the run is 10 ms (solve_ivp integrates
-    the fast rates, up to 1e9/s, with steps that small).
+    the fast rates, ``beta omega^2`` of the highest coordinates, with steps
+    that small).
     """
     rng = random.Random(1000 + seed)
     d = random_system(seed)

@@ -344,8 +344,11 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
     Raises
     ------
     SimulationError
-        When the decomposition is not accurate to 1e-8 (a cluster of equal
-        eigenvalues, a defective block of more than two).
+        When the invariant subspaces are not accurate to 1e-8, the coordinates
+        and their inverse map agree only to more than 1e-6, or the blocks'
+        evolution departs from ``expm`` by more than 1e-6
+        (:func:`exponential_error`): more than half of a state's real rates
+        crowded together, a defective block of more than two.
     """
     n = omega.size
     As, dscale, blocks, residual = block_structure(omega, C)
@@ -354,7 +357,7 @@ def slot_arrays(omega: np.ndarray, C: np.ndarray, Wc: np.ndarray, pw: np.ndarray
             f"non-proportional damping: the state's block decomposition is not accurate ({residual:.2g}); "
             "this damping cannot be integrated exactly"
         )
-    Gs = np.zeros((2 * n, 2 * n))  # the map in the scaled coordinates, columns (z0_k, z1_k) interleaved by block
+    Gs = np.zeros((2 * n, 2 * n))  # the map in the scaled coordinates: columns z0_k (k < n), then z1_k (n + k)
     reg = np.zeros(n, dtype=np.int64)
     dec = np.zeros(n)
     om = np.zeros(n)
