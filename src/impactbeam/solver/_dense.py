@@ -21,8 +21,10 @@ and evaluate it.
   beat the best value found (to ``atol``) are dropped, the others are split, and an
   interior maximum (slope ``+`` to ``-``, ``u''`` proven negative) is refined
   by Newton's method on the velocity with the curvature each evaluation
-  gives. The result is the maximum of the N-mode solution to ``atol``, not
-  of any sampled grid.
+  gives, as is a best point the bisection left (the intervals around it
+  dropped because they could beat it by ``atol`` at most: on a flat maximum
+  that left its time loose by up to a microsecond). The result is the maximum of
+  the N-mode solution to ``atol``, not of any sampled grid.
 * :func:`integral` integrates ``W eta`` in closed form
   (:func:`~impactbeam.solver._closed.integral_of`), e.g. impulses.
 """
@@ -330,18 +332,24 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
     monotone on it (the maximum is then at an end), or when ``u`` is proven
     concave on it (``u'' < 0`` at both ends and ``|u''(t0)| + |u''(t1)| >= M3 L``;
     the maximum is then the root of ``u'``, :func:`_concave_peak`, or an end).
-    The half where ``u'`` turns from + to - is searched first. Returns the
-    new best value and its time, NaN when ``best`` was not beaten.
+    The half where ``u'`` turns from + to - is searched first. A best point
+    left by the bisection is refined to the root of ``u'`` that the slopes
+    around it bracket, when that is higher. Returns the new best value and
+    its time, NaN when ``best`` was not beaten.
     """
     tbest = np.nan
     ua, da, ca = _row3(ta, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
     ub, db, cb = _row3(tb, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+    # the interval the best point was found in (its midpoint or an end), the slopes at its ends and there
+    n0, nd0, n1, nd1, ndt = ta, da, tb, db, 0.0
     if ua > best:
         best = ua
         tbest = ta
+        ndt = da
     if ub > best:
         best = ub
         tbest = tb
+        ndt = db
     _push(stack, 0, ta, ua, da, ca, tb, ub, db, cb)
     top = 1
     while top > 0:
@@ -371,12 +379,14 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
             if um > best:
                 best = um
                 tbest = tm
+                n1 = n0  # already the root of u': nothing to refine
             continue
         tm = 0.5 * (t0 + t1)
         um, dm, cm = _row3(tm, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
         if um > best:
             best = um
             tbest = tm
+            n0, nd0, n1, nd1, ndt = t0, d0, t1, d1, dm
         if top + 2 > stack.shape[0]:
             continue
         # the half where u' turns from + to - (the right one when u'(tm) > 0) is searched first: its maximum
@@ -388,6 +398,18 @@ def _segment_max(ta, tb, M, M3, best, atol, xtol, stack, reg, a, w, om, VH, VD, 
             _push(stack, top, tm, um, dm, cm, t1, u1, d1, c1)
             _push(stack, top + 1, t0, u0, d0, c0, tm, um, dm, cm)
         top += 2
+    if not np.isnan(tbest) and n1 > n0:
+        # a point of the bisection, the intervals around it dropped when they could beat it by atol at most:
+        # the stationary point its slopes bracket, when that is higher (else a flat maximum's time is only
+        # defined to where the function is within atol of its top: up to a microsecond on a slow response)
+        tm, um = tbest, best
+        if ndt > 0.0 and nd1 < 0.0:
+            tm, um = _concave_peak(tbest, n1, ndt, nd1, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+        elif ndt < 0.0 and nd0 > 0.0:
+            tm, um = _concave_peak(n0, tbest, nd0, ndt, xtol, reg, a, w, om, VH, VD, base, PV, Om, phi, kw)
+        if um > best:
+            best = um
+            tbest = tm
     return best, tbest
 
 
