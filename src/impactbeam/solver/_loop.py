@@ -456,6 +456,15 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
         else:
             ic[I_JUST] = -1
             if te >= pt1[kp]:
+                if gen[s] != 0 and kp + 1 < pt0.size:
+                    # a block's first equation carries the load (alpha, au u(t)): where the next piece makes
+                    # u jump, the coordinates' rates jump with alpha, the state they stand for (to_modal)
+                    # staying continuous
+                    du = (load_value(kp + 1, te, pt0, pconst, pslope, pamp, pOm, pphase)
+                          - load_value(kp, te, pt0, pconst, pslope, pamp, pOm, pphase))
+                    if du != 0.0:
+                        for n in range(nm):
+                            deta[n] += LW[s, 1, n] * du
                 ic[I_PIECE] = kp + 1
         if evals >= budget:
             return CHECKPOINT
