@@ -94,6 +94,9 @@ def test_scenario_reference_covers_the_schema() -> None:
             continue
         assert f"`{path}`" in text, path
     assert "`contactors[].gap`" in text and "`clamped`" in text
+    # the copy kept with the example files (readable without building the docs) is the same page, up to date
+    assert ref.EXAMPLES_COPY.read_text() == ref.render(plain=True), (
+        "examples/scenario-reference.md is out of date: run python docs/_ext/scenario_reference.py")
 
 
 @pytest.mark.docs

@@ -201,8 +201,12 @@ def _kind(node: Any) -> str:
 _ARRAYS = {key for key, node in S._SCHEMA.fields.items() if isinstance(node, S._Array)}
 
 
-def render() -> str:
-    """The Markdown text of the reference page."""
+#: The copy of the page kept with the example files (plain Markdown: readable without building the docs).
+EXAMPLES_COPY = Path(__file__).resolve().parents[2] / "examples" / "scenario-reference.md"
+
+
+def render(plain: bool = False) -> str:
+    """The Markdown text of the reference page; ``plain``: the copy of :data:`EXAMPLES_COPY` (no MyST directive)."""
     problems = check()
     if problems:
         raise RuntimeError("; ".join(problems))
@@ -218,6 +222,9 @@ def render() -> str:
         "`contactors.0.key` in sweeps and `with_values`.",
         "",
     ]
+    if plain:
+        lines += ["This copy, kept with the example files, is written by `python docs/_ext/scenario_reference.py`",
+                  "(the documentation builds the same page); edit the meanings there, not here.", ""]
     groups: dict[str, list[str]] = {}
     for path, node in schema_keys():
         if path not in MEANING:
@@ -237,7 +244,11 @@ def render() -> str:
     lines += ["", "## Support presets", "", "| preset | translational [N/m] | rotational [N m/rad] |", "|---|---|---|"]
     for name, (k, kt) in SUPPORT_PRESETS.items():
         lines.append(f"| `{name}` | {k:g} | {kt:g} |")
-    lines += ["", "## Example", "", "```{literalinclude} ../../examples/case03.toml", ":language: toml", "```", ""]
+    if plain:
+        lines += ["", "## Example", "", "[`case03.toml`](case03.toml), the paper's Case 3; the other files of this",
+                  "directory are described in [README.md](README.md).", ""]
+    else:
+        lines += ["", "## Example", "", "```{literalinclude} ../../examples/case03.toml", ":language: toml", "```", ""]
     return "\n".join(lines)
 
 
@@ -292,3 +303,8 @@ def _write(app: Any) -> None:
 def setup(app: Any) -> dict[str, Any]:
     app.connect("builder-inited", _write)
     return {"parallel_read_safe": True, "version": "1"}
+
+
+if __name__ == "__main__":  # rewrite the copy kept with the example files (tests/test_docs.py checks it)
+    EXAMPLES_COPY.write_text(render(plain=True))
+    print(f"wrote {EXAMPLES_COPY}")
