@@ -439,3 +439,38 @@ def test_cli_not_converged_reports_false_with_a_warning(tmp_path):
     data = json.loads(out.stdout)
     assert data["converged"] is False and data["stable"] is False
     assert any("did not converge" in w for w in data["warnings"])
+
+
+def test_a_jacobian_that_is_not_finite_gives_no_multipliers_and_says_why(tmp_path):
+    # Found by a random hunt: the paper's basis with 4 modes and a stiff dashpot stop (its projection warned),
+    # where every release is a turn-back switch whose normal velocity is a round-off (3e-15 of the scale): the
+    # saltation overflowed and numpy's eigvals raised LinAlgError out of periodic_orbit and the CLI. Now the
+    # orbit is reported converged, without multipliers, not called stable, with a warning saying why.
+    raw = {"beam": {"length": 0.1092, "width": 0.00993, "height": 0.00303, "youngs_modulus": 1834e6,
+                    "density": 951.98, "sections": [{"length": 0.04, "height": 0.004}, {"length": 0.0692}]},
+           "supports": {"left": "clamped", "right": {"translational": "inf", "rotational": 50.0}},
+           "contactors": [{"position_ratio": 0.353, "stiffness": 285673.5, "gap": 5e-05, "side": "below",
+                           "damping": 0.3837},
+                          {"position_ratio": 0.959, "stiffness": 708.29, "gap": 0.0001, "side": "below",
+                           "damping": 0.5707}],
+           "damping": {"free": 0.01, "contact": 2.0},
+           "excitation": {"kind": "point_force", "shape": "harmonic", "amplitude": 1.0, "position": 0.07051,
+                          "frequency": 60.0},
+           "solver": {"modes": 4, "end_time": 1.0, "basis": "paper"}}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        orbit = periodic_orbit(parse_scenario(raw), settle_periods=60)
+    texts = [str(w.message) for w in caught]
+    assert not np.all(np.isfinite(orbit.jacobian))
+    assert orbit.converged and orbit.multipliers.size == 0 and orbit.stable is False
+    assert any("Jacobian is not finite" in t for t in texts)
+    assert not any(issubclass(w.category, RuntimeWarning) for w in caught)  # numpy's overflow is not shown
+    path = tmp_path / "g.toml"
+    path.write_text(parse_scenario(raw).to_toml())
+    out = _cli(["periodic", str(path), "--settle-periods", "60", "--json"])
+    assert out.exit_code == 0
+    data = json.loads(out.stdout)
+    assert data["converged"] is True and data["multipliers"] == [] and data["stable"] is False
+    assert any("Jacobian is not finite" in t for t in data["warnings"])
+    out = _cli(["periodic", str(path), "--settle-periods", "60"])
+    assert out.exit_code == 0 and "multipliers not defined" in out.stdout

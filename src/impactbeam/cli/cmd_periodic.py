@@ -49,7 +49,10 @@ def periodic(scenario: str, multiple: int, settle_periods: float | None, max_ite
              f"  impacts per period: {orbit.impacts_per_period}",
              "  strobe w [mm] at t = start + k/f: " + ", ".join(f"{w * 1e3:.6g}" for w in orbit.strobe)]
     shown = orbit.multipliers[:6]
-    lines.append("  largest multipliers |mu|: " + ", ".join(f"{abs(m):.6g}" for m in shown)
-                 + (" ..." if orbit.multipliers.size > shown.size else ""))
-    lines.append(f"  {'stable' if orbit.stable else 'NOT stable' if orbit.converged else 'not converged'}")
+    if shown.size:
+        lines.append("  largest multipliers |mu|: " + ", ".join(f"{abs(m):.6g}" for m in shown)
+                     + (" ..." if orbit.multipliers.size > shown.size else ""))
+        lines.append(f"  {'stable' if orbit.stable else 'NOT stable' if orbit.converged else 'not converged'}")
+    else:  # the Jacobian is not finite (a grazing contact): the warning says so
+        lines.append("  multipliers not defined: stability unknown" if orbit.converged else "  not converged")
     click.echo("\n".join(lines))  # the warnings go to stderr, printed by handle_errors when the command ends

@@ -276,32 +276,35 @@ def flow_jacobian(sol) -> FlowJacobian:
     J = from_free(pk, int(sol.slot[0]))  # a state engaged already at t = 0 (strictly inside: no crossing)
     events = 0
     grazing: list[tuple[float, float]] = []
-    for j in range(nseg):
-        s = int(sol.slot[j])
-        J = slot_transition(pk, s, float(sol.t1[j] - sol.t0[j])) @ J
-        if j + 1 == nseg:
-            break
-        cs = _switches(sol, j)
-        if not cs:
-            continue
-        x = fld.end_state(j)
-        te = float(sol.t1[j])
-        kp = int(sol.piece[j])
-        mask = int(pk.smask[s])
-        for c in cs:
-            new = _slot_of(pk, mask ^ (1 << c))
-            Tb = _block(_transfer(pk, new, s))
-            f_minus = fld(s, kp, te, x)
-            xp = Tb @ x
-            f_plus = fld(new, kp, te, xp)
-            grad = _switching_gradient(fld, s, mask, c, x)
-            normal = float(grad @ f_minus)
-            if abs(normal) < GRAZING * velocity_scale:
-                grazing.append((te, abs(normal) / velocity_scale))
-            S = Tb if normal == 0.0 else Tb + np.outer(f_plus - Tb @ f_minus, grad) / normal
-            J = S @ J
-            x, s, mask = xp, new, mask ^ (1 << c)
-            events += 1
+    # a grazing contact's saltation (normal velocity near 0) can overflow: the caller sees a matrix that is not
+    # finite and says so (periodic orbit: no multipliers), rather than numpy's warnings
+    with np.errstate(over="ignore", invalid="ignore"):
+        for j in range(nseg):
+            s = int(sol.slot[j])
+            J = slot_transition(pk, s, float(sol.t1[j] - sol.t0[j])) @ J
+            if j + 1 == nseg:
+                break
+            cs = _switches(sol, j)
+            if not cs:
+                continue
+            x = fld.end_state(j)
+            te = float(sol.t1[j])
+            kp = int(sol.piece[j])
+            mask = int(pk.smask[s])
+            for c in cs:
+                new = _slot_of(pk, mask ^ (1 << c))
+                Tb = _block(_transfer(pk, new, s))
+                f_minus = fld(s, kp, te, x)
+                xp = Tb @ x
+                f_plus = fld(new, kp, te, xp)
+                grad = _switching_gradient(fld, s, mask, c, x)
+                normal = float(grad @ f_minus)
+                if abs(normal) < GRAZING * velocity_scale:
+                    grazing.append((te, abs(normal) / velocity_scale))
+                S = Tb if normal == 0.0 else Tb + np.outer(f_plus - Tb @ f_minus, grad) / normal
+                J = S @ J
+                x, s, mask = xp, new, mask ^ (1 << c)
+                events += 1
     last = int(sol.slot[nseg - 1])
     final = to_free(pk, last) @ fld.end_state(nseg - 1)
     return FlowJacobian(to_free(pk, last) @ J, final, events, grazing)

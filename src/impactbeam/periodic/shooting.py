@@ -70,9 +70,11 @@ class PeriodicOrbit:
     strobe : ndarray, (M,), [m]
         ``w`` at the first contactor (the first output point without one) at ``strobe_times``.
     multipliers : ndarray of complex, (2 n,)
-        Eigenvalues of the Jacobian of the map at the orbit, by decreasing modulus.
+        Eigenvalues of the Jacobian of the map at the orbit, by decreasing
+        modulus; empty when that Jacobian is not finite (a grazing contact,
+        whose saltation divides by its normal velocity; a warning says so).
     stable : bool
-        All multipliers strictly inside the unit circle.
+        All multipliers strictly inside the unit circle (False without multipliers).
     impacts_per_period : int
         Impacts (contactors engaging) in one period ``M / f`` of the orbit.
     least_period : int
@@ -387,6 +389,11 @@ def _evaluate(pmap: StroboscopicMap, x: np.ndarray) -> tuple[FlowJacobian | None
     return fj, _residual(pmap, x, fj)
 
 
+#: Why the multipliers of a state can be missing: the saltation of a contact with no normal velocity is infinite.
+_NOT_FINITE = ("the map's Jacobian is not finite at this state (the saltation of a grazing contact divides by its "
+               "normal velocity)")
+
+
 def _newton(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, k0: int, tol: float, max_it: int) -> PeriodicOrbit:
     """Newton's iteration on ``P(x) = x``; the orbit.
 
@@ -403,6 +410,9 @@ def _newton(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, k0: int, t
     stalled = ""
     uphill = 0
     while res > tol and it < max_it:
+        if not np.all(np.isfinite(fj.matrix)):
+            stalled = _NOT_FINITE
+            break
         try:
             dx = np.linalg.solve(fj.matrix - eye, x - fj.final)
         except np.linalg.LinAlgError:
@@ -463,9 +473,12 @@ def _report(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, fj: FlowJa
             "the orbit's scale): the map is not smooth there, so the multipliers hold only for very small "
             "perturbations and Newton may converge slowly"
         )
+    finite = bool(np.all(np.isfinite(fj.matrix)))
+    if not finite:
+        notes.append(f"periodic orbit: {_NOT_FINITE}: no multipliers are given and the orbit is not called stable")
     for text in notes:
         emit_user_level_warning(text)
-    mult = np.linalg.eigvals(fj.matrix)
+    mult = np.linalg.eigvals(fj.matrix) if finite else np.empty(0, dtype=complex)
     mult = mult[np.argsort(-np.abs(mult), kind="stable")]
     sol = pmap.solve(x)
     t_s = exc.start + (k0 + pmap.phase) / f
@@ -478,9 +491,12 @@ def _report(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, fj: FlowJa
     impacts = sum(1 for ev in sol.events if ev.kind == "impact" and ev.time > 0.0)
     least = _least_period(pmap, sol, x) if converged else M
     rho = float(np.abs(mult).max()) if mult.size else 0.0
-    stable = bool(converged and rho < 1.0)
+    stable = bool(converged and finite and rho < 1.0)
     msg = (f"converged in {it} Newton step(s), relative residual {residuals[-1]:.2g}; largest multiplier "
            f"modulus {rho:.6g} ({'stable' if stable else 'unstable' if converged else 'not converged'})")
+    if converged and not finite:
+        msg = (f"converged in {it} Newton step(s), relative residual {residuals[-1]:.2g}; multipliers not defined "
+               "(the map's Jacobian is not finite at a grazing contact)")
     if not converged:
         msg = f"not converged after {it} Newton step(s): relative residual {residuals[-1]:.2g}"
     elif least < M:
