@@ -33,7 +33,11 @@ paper's per-state modes the lossy projection leaves a non-zero correction.
 (its derivative grows like ``1 / (grad g . f-)``). A dashpot contactor is
 released where its force ``k d + c d'`` vanishes, and engaged again by that
 force while still compressed: then ``g`` is the force and its gradient holds
-the velocity (:func:`_switching_gradient`).
+the velocity (:func:`_switching_gradient`). With the paper's basis a switch's
+projection can leave another contactor on the wrong side, which the engine
+switches at the same instant: that instant is the first switch's, so the
+two jumps make one, ``S = T2 T1 + (f++ - T2 T1 f-) grad g1^T / (grad g1 . f-)``
+(:func:`_off_surface` tells such a switch from a crossing).
 """
 
 from __future__ import annotations
@@ -225,6 +229,20 @@ def _switching_gradient(fld: _Field, s: int, mask: int, c: int, x: np.ndarray) -
     return np.concatenate([W, r * W])
 
 
+def _off_surface(fld: _Field, grad: np.ndarray, c: int, x: np.ndarray) -> bool:
+    """Whether contactor ``c``'s switching function (gradient ``grad``) is away from zero at ``x``.
+
+    Its value is ``side grad . x - gap`` (the penetration, or the force over
+    the stiffness); a switch made where it is zero crossed it, one made where
+    it is not (beyond :data:`_PHASE` of the beam's length) was made because
+    another switch at that instant (the paper's projection) left the
+    contactor on the wrong side: the engine switches it at once, at a time
+    its own function does not set.
+    """
+    value = float(fld.side[c]) * float(grad @ x) - float(fld.gap[c])
+    return abs(value) > _PHASE * float(fld.pk.space.beam.length)
+
+
 def _switches(sol, j: int) -> list[int]:
     """Contactors switched, in order, between segment ``j`` and ``j + 1``."""
     pk = sol.packed
@@ -291,20 +309,29 @@ def flow_jacobian(sol) -> FlowJacobian:
             te = float(sol.t1[j])
             kp = int(sol.piece[j])
             mask = int(pk.smask[s])
-            for c in cs:
-                new = _slot_of(pk, mask ^ (1 << c))
-                Tb = _block(_transfer(pk, new, s))
-                f_minus = fld(s, kp, te, x)
-                xp = Tb @ x
-                f_plus = fld(new, kp, te, xp)
+            i = 0
+            while i < len(cs):
+                # a switch, with those made at once after it because it left their contactors on the wrong side
+                # (the paper's projection): one jump at the instant the first one's function sets
+                c = cs[i]
                 grad = _switching_gradient(fld, s, mask, c, x)
+                T = np.eye(x.size)
+                xp, s_new, mask_new, k = x, s, mask, i
+                while k < len(cs) and (k == i or _off_surface(fld, _switching_gradient(fld, s_new, mask_new, cs[k],
+                                                                                          xp), cs[k], xp)):
+                    nxt = _slot_of(pk, mask_new ^ (1 << cs[k]))
+                    Tb = _block(_transfer(pk, nxt, s_new))
+                    T, xp, s_new, mask_new, k = Tb @ T, Tb @ xp, nxt, mask_new ^ (1 << cs[k]), k + 1
+                f_minus = fld(s, kp, te, x)
+                f_plus = fld(s_new, kp, te, xp)
                 normal = float(grad @ f_minus)
                 if abs(normal) < GRAZING * velocity_scale:
                     grazing.append((te, abs(normal) / velocity_scale))
-                S = Tb if normal == 0.0 else Tb + np.outer(f_plus - Tb @ f_minus, grad) / normal
+                S = T if normal == 0.0 else T + np.outer(f_plus - T @ f_minus, grad) / normal
                 J = S @ J
-                x, s, mask = xp, new, mask ^ (1 << c)
-                events += 1
+                x, s, mask = xp, s_new, mask_new
+                events += k - i
+                i = k
     last = int(sol.slot[nseg - 1])
     final = to_free(pk, last) @ fld.end_state(nseg - 1)
     return FlowJacobian(to_free(pk, last) @ J, final, events, grazing)
