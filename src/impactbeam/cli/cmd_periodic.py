@@ -53,6 +53,7 @@ def periodic(scenario: str, multiple: int, settle_periods: float | None, max_ite
         lines.append("  largest multipliers |mu|: " + ", ".join(f"{abs(m):.6g}" for m in shown)
                      + (" ..." if orbit.multipliers.size > shown.size else ""))
         lines.append(f"  {'stable' if orbit.stable else 'NOT stable' if orbit.converged else 'not converged'}")
-    else:  # the Jacobian is not finite (a grazing contact): the warning says so
-        lines.append("  multipliers not defined: stability unknown" if orbit.converged else "  not converged")
+    else:  # the Jacobian is not finite: the warning says so
+        lines.append("  multipliers not defined (the map's Jacobian is not finite)")
+        lines.append("  stability unknown" if orbit.converged else "  not converged")
     click.echo("\n".join(lines))  # the warnings go to stderr, printed by handle_errors when the command ends

@@ -37,7 +37,11 @@ the velocity (:func:`_switching_gradient`). With the paper's basis a switch's
 projection can leave another contactor on the wrong side, which the engine
 switches at the same instant: that instant is the first switch's, so the
 two jumps make one, ``S = T2 T1 + (f++ - T2 T1 f-) grad g1^T / (grad g1 . f-)``
-(:func:`_off_surface` tells such a switch from a crossing).
+(:func:`_off_surface` tells such a switch from a crossing). A contactor the
+projection leaves on the wrong side with nothing else switching is switched
+where the rate of its function vanishes (the engine's turn-back rule): that
+rate, ``grad g . f``, times the event, so ``grad g`` becomes ``A^T grad g``
+(``A = df/dx``) and the normal velocity ``grad g . (A f + df/dt)``.
 """
 
 from __future__ import annotations
@@ -177,6 +181,20 @@ class _Field:
         damp = pk.Cd[s] @ deta if pk.gen[s] else 2.0 * pk.dec[s] * deta
         acc = self.force(s, kp, t) - damp - pk.omo[s] ** 2 * eta
         return np.concatenate([deta, acc])
+
+    def linear(self, s: int) -> np.ndarray:
+        """``d f / d x`` in slot ``s`` (the field is affine in the state)."""
+        pk = self.pk
+        n = pk.n_modes
+        damp = pk.Cd[s] if pk.gen[s] else np.diag(2.0 * pk.dec[s])
+        return np.block([[np.zeros((n, n)), np.eye(n)], [-np.diag(pk.omo[s] ** 2), -damp]])
+
+    def rate(self, s: int, kp: int, t: float) -> np.ndarray:
+        """``d f / d t`` at fixed state in slot ``s``, load piece ``kp``: the rate of the load."""
+        pk = self.pk
+        tau = t - self.pt0[kp]
+        du = self.pslope[kp] + self.pamp[kp] * self.pOm[kp] * math.cos(self.pOm[kp] * tau + self.pphase[kp])
+        return np.concatenate([np.zeros(pk.n_modes), pk.pw[s] * du])
 
     def end_state(self, j: int) -> np.ndarray:
         """Modal state at the end of segment ``j`` (closed form of the engine's kernels)."""
@@ -325,6 +343,12 @@ def flow_jacobian(sol) -> FlowJacobian:
                 f_minus = fld(s, kp, te, x)
                 f_plus = fld(s_new, kp, te, xp)
                 normal = float(grad @ f_minus)
+                if _off_surface(fld, grad, c, x):
+                    # the first switch of its instant, off its surface: a turn-back (the paper's projection left
+                    # the contactor on the wrong side, and the engine switches it where the function's rate
+                    # vanishes), whose instant is set by that rate: its gradient and its own rate along the flow
+                    grad, normal = fld.linear(s).T @ grad, float(fld.linear(s).T @ grad @ f_minus
+                                                                 + grad @ fld.rate(s, kp, te))
                 if abs(normal) < GRAZING * velocity_scale:
                     grazing.append((te, abs(normal) / velocity_scale))
                 S = T if normal == 0.0 else T + np.outer(f_plus - T @ f_minus, grad) / normal

@@ -71,8 +71,9 @@ class PeriodicOrbit:
         ``w`` at the first contactor (the first output point without one) at ``strobe_times``.
     multipliers : ndarray of complex, (2 n,)
         Eigenvalues of the Jacobian of the map at the orbit, by decreasing
-        modulus; empty when that Jacobian is not finite (a grazing contact,
-        whose saltation divides by its normal velocity; a warning says so).
+        modulus; empty when that Jacobian is not finite (a saltation divides
+        by a switch's normal velocity, zero at a grazing contact; a warning
+        says so).
     stable : bool
         All multipliers strictly inside the unit circle (False without multipliers).
     impacts_per_period : int
@@ -390,8 +391,8 @@ def _evaluate(pmap: StroboscopicMap, x: np.ndarray) -> tuple[FlowJacobian | None
 
 
 #: Why the multipliers of a state can be missing: the saltation of a contact with no normal velocity is infinite.
-_NOT_FINITE = ("the map's Jacobian is not finite at this state (the saltation of a grazing contact divides by its "
-               "normal velocity)")
+_NOT_FINITE = ("the map's Jacobian is not finite at this state (a saltation divided by a switch's normal velocity, "
+               "which is zero at a grazing contact)")
 
 
 def _newton(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, k0: int, tol: float, max_it: int) -> PeriodicOrbit:
@@ -496,7 +497,7 @@ def _report(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, fj: FlowJa
            f"modulus {rho:.6g} ({'stable' if stable else 'unstable' if converged else 'not converged'})")
     if converged and not finite:
         msg = (f"converged in {it} Newton step(s), relative residual {residuals[-1]:.2g}; multipliers not defined "
-               "(the map's Jacobian is not finite at a grazing contact)")
+               "(the map's Jacobian is not finite)")
     if not converged:
         msg = f"not converged after {it} Newton step(s): relative residual {residuals[-1]:.2g}"
     elif least < M:
