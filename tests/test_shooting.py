@@ -469,6 +469,7 @@ def test_a_switch_made_at_once_by_the_one_before_moves_with_its_instant():
     A, B = _scaled(orbit.map, orbit.jacobian), _scaled(orbit.map, J_fd)
     assert np.linalg.norm(A - B) / np.linalg.norm(A) < 2e-5
     mu_fd = np.linalg.eigvals(J_fd)
+    # the largest multiplier: measured 2.5e-7 apart (the same residual); the old code's was 0.034 off
     assert abs(np.abs(orbit.multipliers).max() - np.abs(mu_fd).max()) < 1e-5
 
 
@@ -513,7 +514,7 @@ def test_a_jacobian_that_is_not_finite_gives_no_multipliers_and_says_why(tmp_pat
 
     def overflowing(sol):
         fj = real(sol)
-        return dataclasses.replace(fj, matrix=fj.matrix * np.inf)
+        return dataclasses.replace(fj, matrix=np.full_like(fj.matrix, np.inf))
 
     monkeypatch.setattr(shooting, "flow_jacobian", overflowing)
     raw = _raw(frequency=60.0)

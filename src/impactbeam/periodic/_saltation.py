@@ -347,8 +347,8 @@ def flow_jacobian(sol) -> FlowJacobian:
                     # the first switch of its instant, off its surface: a turn-back (the paper's projection left
                     # the contactor on the wrong side, and the engine switches it where the function's rate
                     # vanishes), whose instant is set by that rate: its gradient and its own rate along the flow
-                    grad, normal = fld.linear(s).T @ grad, float(fld.linear(s).T @ grad @ f_minus
-                                                                 + grad @ fld.rate(s, kp, te))
+                    rate_grad = fld.linear(s).T @ grad
+                    grad, normal = rate_grad, float(rate_grad @ f_minus + grad @ fld.rate(s, kp, te))
                 if abs(normal) < GRAZING * velocity_scale:
                     grazing.append((te, abs(normal) / velocity_scale))
                 S = T if normal == 0.0 else T + np.outer(f_plus - T @ f_minus, grad) / normal
