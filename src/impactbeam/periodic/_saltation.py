@@ -33,7 +33,8 @@ paper's per-state modes the lossy projection leaves a non-zero correction.
 (its derivative grows like ``1 / (grad g . f-)``). A dashpot contactor is
 released where its force ``k d + c d'`` vanishes, and engaged again by that
 force while still compressed: then ``g`` is the force and its gradient holds
-the velocity (:func:`_switching_gradient`). With the paper's basis a switch's
+the velocity (:func:`_switching_gradient`; the released phase is tracked as
+the engine does, :func:`_released`). With the paper's basis a switch's
 projection can leave another contactor on the wrong side, which the engine
 switches at the same instant: that instant is the first switch's, so the
 two jumps make one, ``S = T2 T1 + (f++ - T2 T1 f-) grad g1^T / (grad g1 . f-)``
@@ -41,7 +42,10 @@ two jumps make one, ``S = T2 T1 + (f++ - T2 T1 f-) grad g1^T / (grad g1 . f-)``
 projection leaves on the wrong side with nothing else switching is switched
 where the rate of its function vanishes (the engine's turn-back rule): that
 rate, ``grad g . f``, times the event, so ``grad g`` becomes ``A^T grad g``
-(``A = df/dx``) and the normal velocity ``grad g . (A f + df/dt)``.
+(``A = df/dx``) and the normal velocity ``grad g . (A f + df/dt)``. A switch
+undone at the same instant leaves no event but, with the paper's basis, a
+moved state: such pairs are restored from the states either side of the
+instant (:func:`_restored`).
 """
 
 from __future__ import annotations
@@ -51,6 +55,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..solver._codes import TOUCH
+
 __all__ = ["FlowJacobian", "flow_jacobian", "segment_transition", "slot_transition", "to_free", "from_free",
            "GRAZING"]
 
@@ -58,9 +64,9 @@ __all__ = ["FlowJacobian", "flow_jacobian", "segment_transition", "slot_transiti
 #: near a grazing contact the map grows like the square root of the penetration (its derivative
 #: like 1/velocity), so a Jacobian there holds only in a tiny neighbourhood.
 GRAZING = 1e-4
-#: A dashpot contactor that engages with a compression above this fraction of the beam's length is in its
-#: released phase (engaged by its force, not its opening); at an ordinary impact the compression is round-off.
-_PHASE = 1e-9
+#: A switching function further than this fraction of the beam's length from zero at its switch was not
+#: crossed there (:func:`_off_surface`); at a crossing it is round-off.
+_OFF = 1e-9
 
 
 @dataclass
@@ -196,8 +202,8 @@ class _Field:
         du = self.pslope[kp] + self.pamp[kp] * self.pOm[kp] * math.cos(self.pOm[kp] * tau + self.pphase[kp])
         return np.concatenate([np.zeros(pk.n_modes), pk.pw[s] * du])
 
-    def end_state(self, j: int) -> np.ndarray:
-        """Modal state at the end of segment ``j`` (closed form of the engine's kernels)."""
+    def end_state(self, j: int, at_start: bool = False) -> np.ndarray:
+        """Modal state at the end of segment ``j`` (or at its start), in the closed form of the engine's kernels."""
         from ..solver._closed import segment_setup, state_at, workspace
         from ..solver._elementary import kernel_work
 
@@ -212,7 +218,7 @@ class _Field:
                                 h0, dh0, P, lA, lB, lD, lE, AL)
         e = np.empty(pk.n_modes)
         d = np.empty(pk.n_modes)
-        tau = float(sol.t1[j] - sol.t0[j])
+        tau = 0.0 if at_start else float(sol.t1[j] - sol.t0[j])
         state_at(tau, pk.reg[s], pk.dec[s], pk.wdh[s], pk.om[s], h0, dh0, P, Om, phi, e, d, kernel_work(pk.n_modes))
         if pk.gen[s]:  # block coordinates (z, z') into the modal frame, as the engine's samples
             from ..solver._closed import alpha_at
@@ -225,26 +231,57 @@ class _Field:
         return np.concatenate([e, d])
 
 
-def _switching_gradient(fld: _Field, s: int, mask: int, c: int, x: np.ndarray) -> np.ndarray:
+def _switching_gradient(fld: _Field, s: int, mask: int, c: int, x: np.ndarray, phase: np.ndarray) -> np.ndarray:
     """Gradient (up to a factor) of the function whose zero switches contactor ``c`` out of slot ``s``.
 
     The engine's rows (:func:`~impactbeam.solver._loop.contactor_rows`): the
     opening or penetration ``d = s w(a) - gap``, whose gradient is
     ``(W(a), 0)``; with a dashpot, a release where the force ``k d + c_d d'``
-    vanishes and a re-engagement while still compressed (``d > 0``, the
-    released phase), both ``(W(a), (c_d / k) W(a))``.
+    vanishes and a re-engagement while still compressed (the released phase,
+    ``phase[c]``: :func:`_released`), both ``(W(a), (c_d / k) W(a))``.
     """
     pk = fld.pk
-    n = pk.n_modes
     W = pk.Wc[s, c]
     r = 0.0
     dash = float(pk.dash[c]) if pk.dash.size else 0.0
-    if dash > 0.0:
-        engaged = (mask >> c) & 1
-        compressed = fld.side[c] * float(W @ x[:n]) - fld.gap[c] > _PHASE * float(pk.space.beam.length)
-        if engaged or compressed:
-            r = dash / fld.kst[c]
+    if dash > 0.0 and ((mask >> c) & 1 or phase[c]):
+        r = dash / fld.kst[c]
     return np.concatenate([W, r * W])
+
+
+def _phase_ends(fld: _Field, s: int, x: np.ndarray, phase: np.ndarray) -> None:
+    """End the released phase of the contactors whose penetration at ``x`` is back within the touch tolerance.
+
+    The engine ends it where the penetration returns to zero (a segment
+    boundary without a switch); a switch at the same point sees it ended.
+    """
+    touch = TOUCH * float(fld.pk.space.beam.length)
+    for c in np.flatnonzero(phase):
+        if _penetration(fld, s, int(c), x) <= touch:
+            phase[c] = False
+
+
+def _penetration(fld: _Field, s: int, c: int, x: np.ndarray) -> float:
+    """``side w(a_c) - gap`` at the modal state ``x`` of slot ``s``."""
+    n = fld.pk.n_modes
+    return float(fld.side[c]) * float(fld.pk.Wc[s, c] @ x[:n]) - float(fld.gap[c])
+
+
+def _released(fld: _Field, s: int, mask: int, c: int, x: np.ndarray, phase: np.ndarray) -> None:
+    """Update ``phase[c]`` for a switch of ``c`` out of slot ``s`` at ``x`` (before its projection), as the engine.
+
+    A dashpot contactor released while compressed beyond the touch tolerance
+    (by the force ``k d + c_d d'`` changing sign) is in its released phase
+    until its penetration returns to zero: meanwhile its force, not its
+    opening, re-engages it (:func:`~impactbeam.solver._loop._switch`). The
+    phase is judged on the penetration before the release's projection, which
+    with the paper's basis may leave the contactor compressed after a release
+    at zero penetration: that one is switched back by its opening's turn-back.
+    """
+    dash = float(fld.pk.dash[c]) if fld.pk.dash.size else 0.0
+    engaging = not (mask >> c) & 1
+    phase[c] = (not engaging and dash > 0.0
+                and _penetration(fld, s, c, x) > TOUCH * float(fld.pk.space.beam.length))
 
 
 def _off_surface(fld: _Field, grad: np.ndarray, c: int, x: np.ndarray) -> bool:
@@ -252,23 +289,29 @@ def _off_surface(fld: _Field, grad: np.ndarray, c: int, x: np.ndarray) -> bool:
 
     Its value is ``side grad . x - gap`` (the penetration, or the force over
     the stiffness); a switch made where it is zero crossed it, one made where
-    it is not (beyond :data:`_PHASE` of the beam's length) was made because
+    it is not (beyond `_OFF` of the beam's length) was made because
     another switch at that instant (the paper's projection) left the
     contactor on the wrong side: the engine switches it at once, at a time
     its own function does not set.
     """
     value = float(fld.side[c]) * float(grad @ x) - float(fld.gap[c])
-    return abs(value) > _PHASE * float(fld.pk.space.beam.length)
+    return abs(value) > _OFF * float(fld.pk.space.beam.length)
 
 
 def _switches(sol, j: int) -> list[int]:
-    """Contactors switched, in order, between segment ``j`` and ``j + 1``."""
+    """Contactors switched, in order, between segment ``j`` and ``j + 1``.
+
+    Several switches at one instant may end in the state they began from
+    (with the paper's basis, each projection leaving the next contactor on
+    the wrong side): the events at the instant say which.
+    """
     pk = sol.packed
     m0, m1 = int(pk.smask[sol.slot[j]]), int(pk.smask[sol.slot[j + 1]])
-    if m0 == m1:
-        return []
     te = float(sol.t1[j])
-    order = [ev.contactor for ev in sol.events if ev.time == te]
+    ev_t, _, ev_c = sol.event_arrays[:3]
+    order = [int(c) for c in ev_c[ev_t == te]]
+    if m0 == m1 and not order:
+        return []
     mask, out = m0, []
     for c in order:
         mask ^= 1 << c
@@ -276,6 +319,43 @@ def _switches(sol, j: int) -> list[int]:
     if mask != m1:  # events cancelled at one instant: toggle the differing bits in index order
         out = [c for c in range(len(sol.contactors)) if ((m0 ^ m1) >> c) & 1]
     return out
+
+
+def _restored(fld: _Field, j: int, x: np.ndarray, recorded: list[int]) -> list[int]:
+    """The switches made at the end of segment ``j``: ``recorded``, with the pairs the event record drops.
+
+    The engine records a switch of a contactor followed at the same instant
+    by its undoing as no event (they cancel: :func:`~impactbeam.solver._loop._switch`).
+    With the shared basis the pair changes nothing; with the paper's
+    per-state modes its two projections (paper eq. 12) move the state. The
+    switches are those whose projections carry ``x`` (the end of segment
+    ``j``) to the start of segment ``j + 1`` (to 1e-9 of its norm): the
+    recorded ones, else with one or two pairs ``(c, c)`` inserted.
+    """
+    sol, pk = fld.sol, fld.pk
+    s, after = int(sol.slot[j]), int(sol.slot[j + 1])
+    target = fld.end_state(j + 1, at_start=True)
+    tol = 1e-9 * max(float(np.linalg.norm(target)), np.finfo(float).tiny)
+    slots = {int(m): i for i, m in reversed(list(enumerate(pk.smask[: pk.nslots])))}
+
+    def lands(seq: list[int]) -> bool:
+        xp, sl, mask = x, s, int(pk.smask[s])
+        for c in seq:
+            mask ^= 1 << c
+            if mask not in slots:  # a state the engine never entered
+                return False
+            xp, sl = _block(_transfer(pk, slots[mask], sl)) @ xp, slots[mask]
+        return sl == after and float(np.linalg.norm(xp - target)) <= tol
+
+    if lands(recorded):
+        return recorded
+    tries = [recorded]
+    for _ in range(2):
+        tries = [t[:i] + [c, c] + t[i:] for t in tries for i in range(len(t) + 1) for c in range(fld.gap.size)]
+        for seq in tries:
+            if lands(seq):
+                return seq
+    return recorded
 
 
 def _velocity_scale(sol) -> float:
@@ -312,6 +392,7 @@ def flow_jacobian(sol) -> FlowJacobian:
     J = from_free(pk, int(sol.slot[0]))  # a state engaged already at t = 0 (strictly inside: no crossing)
     events = 0
     grazing: list[tuple[float, float]] = []
+    phase = np.zeros(fld.gap.size, dtype=bool)  # dashpot contactors in their released phase (_released)
     # a grazing contact's saltation (normal velocity near 0) can overflow: the caller sees a matrix that is not
     # finite and says so (periodic orbit: no multipliers), rather than numpy's warnings
     with np.errstate(over="ignore", invalid="ignore"):
@@ -320,10 +401,11 @@ def flow_jacobian(sol) -> FlowJacobian:
             J = slot_transition(pk, s, float(sol.t1[j] - sol.t0[j])) @ J
             if j + 1 == nseg:
                 break
-            cs = _switches(sol, j)
+            x = fld.end_state(j)
+            _phase_ends(fld, s, x, phase)
+            cs = _restored(fld, j, x, _switches(sol, j))
             if not cs:
                 continue
-            x = fld.end_state(j)
             te = float(sol.t1[j])
             kp = int(sol.piece[j])
             mask = int(pk.smask[s])
@@ -332,11 +414,12 @@ def flow_jacobian(sol) -> FlowJacobian:
                 # a switch, with those made at once after it because it left their contactors on the wrong side
                 # (the paper's projection): one jump at the instant the first one's function sets
                 c = cs[i]
-                grad = _switching_gradient(fld, s, mask, c, x)
+                grad = _switching_gradient(fld, s, mask, c, x, phase)
                 T = np.eye(x.size)
                 xp, s_new, mask_new, k = x, s, mask, i
                 while k < len(cs) and (k == i or _off_surface(fld, _switching_gradient(fld, s_new, mask_new, cs[k],
-                                                                                          xp), cs[k], xp)):
+                                                                                          xp, phase), cs[k], xp)):
+                    _released(fld, s_new, mask_new, cs[k], xp, phase)
                     nxt = _slot_of(pk, mask_new ^ (1 << cs[k]))
                     Tb = _block(_transfer(pk, nxt, s_new))
                     T, xp, s_new, mask_new, k = Tb @ T, Tb @ xp, nxt, mask_new ^ (1 << cs[k]), k + 1

@@ -13,7 +13,7 @@ __all__ = ["DONE", "CHATTER", "NEED_STATE", "NEED_TRANSFER", "NEED_SPACE", "CHEC
            "I_SLOT", "I_PIECE", "I_JUST", "I_PENDING", "I_NSEG", "I_NEV", "I_NJUMP", "I_NSLOTS", "I_NTR",
            "I_WARN_C", "REQ_A", "REQ_B", "I_RESUME", "I_EVALS", "I_SAME", "I_WARN_N", "I_USED", "N_INT",
            "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "N_FLOAT", "MOVED_WARN",
-           "MOVED_FLOOR"]
+           "MOVED_FLOOR", "TOUCH"]
 
 DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
 CASE_DONE = 6  # a batch finished a case and stops after each (a continuation)
@@ -29,3 +29,5 @@ N_FLOAT = 6
 # and warned about (engine.projection_warning), by the engine and the solve_ivp path alike
 MOVED_WARN = 0.05
 MOVED_FLOOR = 1e6
+# the touch tolerance, as a fraction of the beam's length: a row within TOUCH L of its surface touches it (tol_h)
+TOUCH = 1e-12

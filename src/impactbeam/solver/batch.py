@@ -176,7 +176,7 @@ def integrate_batch(
 
     rows = table_rows()
     Wm = Wcp = np.zeros((0, nm))
-    tol_h = 1e-12 * beam.length
+    tol_h = _loop.TOUCH * beam.length
     atol = 1e-12 * float(pk.space.beam.length)
     while True:
         if Wm.shape[0] != pk.nslots:  # the shapes at the metric point and the contactors, in every built state

@@ -375,7 +375,7 @@ def integrate(
         np.array([c.stiffness for c in contactors], dtype=float),
     )
     pcs = _pieces(excitation, options.end_time)
-    tol_h = 1e-12 * beam.length
+    tol_h = _loop.TOUCH * beam.length
     fc = np.zeros(_loop.N_FLOAT)
     fc[_loop.F_LAST_T] = -1.0
     ic = np.zeros(_loop.N_INT, dtype=np.int64)

@@ -51,7 +51,7 @@ from ..model.beam import Beam, Contactor
 from ..exceptions import SimulationError
 from ..model.loading import Excitation
 from ..model.starting import InitialCondition, Preload
-from ._codes import MOVED_FLOOR, MOVED_WARN
+from ._codes import MOVED_FLOOR, MOVED_WARN, TOUCH
 from .engine import make_space
 from .initial import initial_coordinates
 from .reference_dense import IvpDense, IvpSegment, IvpSolution
@@ -142,7 +142,7 @@ class _Reference:
         self.gap = np.array([c.gap for c in contactors], dtype=float)
         self.side = np.array([c.direction for c in contactors], dtype=float)
         self.stiff = np.array([c.stiffness for c in contactors], dtype=float)
-        self.tol = 1e-12 * beam.length  # the touch tolerance of the engine (tol_h)
+        self.tol = TOUCH * beam.length  # the touch tolerance of the engine (tol_h)
         T = options.end_time
         all_eng = tuple(range(len(contactors)))
         states = [self.space.state(())] + ([self.space.state(all_eng)] if contactors else [])

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..exceptions import ParameterError
 from . import kernels
+from ._codes import TOUCH
 
 if TYPE_CHECKING:
     from ..model.beam import Contactor
@@ -340,7 +341,7 @@ class Solution(PiecewiseSolution):
         self.evaluations = evaluations
         self.n_modes = n_modes
         self.dashpots = packed.dash
-        self._atol = 1e-12 * float(packed.space.beam.length)
+        self._atol = TOUCH * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)
         if event_arrays is None:  # times, kinds (1 impact, 0 rebound), contactors, velocities
             event_arrays = (np.array([e.time for e in events], dtype=float),
