@@ -170,7 +170,48 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
         out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
     if impacts:
         out["impacts"] = _impact_table(result, rows) if np.isfinite(scalars[0]) else []
+        text = touch_scale_warning(rows, result.beam.length) if out["impacts"] else None
+        if text is not None:
+            from .._warnings import emit_user_level_warning
+
+            emit_user_level_warning(text)
     return out
+
+
+#: An impact whose peak compression is at most this many touch tolerances (the engine's 1e-12 of the beam's
+#: length) is resolved only at that scale; :func:`touch_scale_warning` speaks of them from TOUCH_SCALE_COUNT on.
+TOUCH_SCALE = 100
+TOUCH_SCALE_COUNT = 10
+
+
+def touch_scale_warning(rows: tuple, length: float) -> str | None:
+    """The warning of impacts too shallow to count, or None (fewer than :data:`TOUCH_SCALE_COUNT` of them).
+
+    A contactor that bounces with every rebound smaller than the last (a
+    restitution or dashpot stop at a small gap, a beam settling onto it)
+    makes a sequence of impacts without end in theory; the engine follows it
+    down to the touch tolerance, so the impacts of its tail, each at most
+    :data:`TOUCH_SCALE` touch tolerances deep, are as many as that tolerance
+    makes them. ``rows`` as :meth:`~impactbeam.solver.solution.Solution.metric_arrays`
+    returns them with the table.
+    """
+    from ..solver._codes import TOUCH
+
+    rc, start, _, _, compression, force = rows[:6]
+    depth = TOUCH_SCALE * TOUCH * length
+    shallow = np.isfinite(compression) & (compression <= depth)
+    n = int(np.count_nonzero(shallow))
+    if n < TOUCH_SCALE_COUNT:
+        return None
+    which = ", ".join(str(int(c)) for c in np.unique(rc[shallow]))
+    return (
+        f"metrics: {n} of {rc.size} impacts (contactor {which}, between t = {start[shallow].min():.6g} and "
+        f"{start[shallow].max():.6g} s) are at most {depth:.2g} m deep ({TOUCH_SCALE} touch tolerances; peak force "
+        f"at most {np.nanmax(force[shallow]):.2g} N), resolved only at the scale of the touch tolerance (1e-12 of "
+        "the beam length): a contact bouncing with ever smaller rebounds as it settles onto its stop (a dashpot or "
+        "restitution stop at a small gap) makes such impacts without end, as many as that tolerance resolves; "
+        "n_impacts and the impact table count them"
+    )
 
 
 def metrics_dict(scalars: np.ndarray) -> dict[str, Any]:
