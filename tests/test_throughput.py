@@ -161,6 +161,28 @@ def test_the_solution_does_not_depend_on_where_the_run_returns_to_python(monkeyp
         np.testing.assert_array_equal(u, v)
 
 
+def test_a_run_of_switches_with_few_scan_steps_returns_to_python(monkeypatch):
+    """A contact settling by ever smaller bounces: 5834 switches, about one scan step each.
+
+    The budget of a call counted scan steps alone, so such a run reached no checkpoint: a first run in a
+    process stayed on the interpreted kernels throughout (46 s on the test machine; 0.9 s since), with no
+    progress report and no Ctrl-C until it ended. Switches and segment set-ups count too now; the solution is
+    the same to the bit wherever the run returns.
+    """
+    from test_dissipation import _SETTLING
+
+    sc = ib.parse_scenario(_SETTLING)
+    with kernels.forced("compiled"):  # the compiled budget from the start (an interpreted one is 200 times less)
+        plain = ib.simulate(sc).solution
+        monkeypatch.setattr(engine, "_BUDGET", 20_000)
+        assert plain.evaluations < 20_000  # scan steps alone would not have returned once
+        seen = []
+        cut = ib.simulate(sc, progress=seen.append).solution
+    assert len(seen) > 10  # measured 33 (32 returns and the end); the old budget: 1 (the end)
+    for u, v in zip(_records(plain), _records(cut)):
+        np.testing.assert_array_equal(u, v)
+
+
 @pytest.mark.parametrize("kind", ["compiled", "interpreted"])
 def test_pairwise_sum_is_numpy_sum(kind):
     K = kernels.compiled() if kind == "compiled" else kernels.interpreted()

@@ -42,10 +42,13 @@ the arrays passed in):
 * ``NEED_TRANSFER``: the transfer matrix from slot ``ic[REQ_A]`` to slot
   ``ic[REQ_B]`` is missing;
 * ``NEED_SPACE``: a record array is full;
-* ``CHECKPOINT``: the evaluation budget of one call is spent (progress
-  reports and Ctrl-C are handled by Python there; a scan stopped inside a
-  segment resumes exactly where it was, so the solution does not depend on
-  the budget or on any return to Python);
+* ``CHECKPOINT``: the budget of one call is spent (progress reports, Ctrl-C
+  and the move from the interpreted to the compiled kernels are handled by
+  Python there; a scan stopped inside a segment resumes exactly where it
+  was, so the solution does not depend on the budget or on any return to
+  Python). The budget counts scan steps, and :data:`PASS_COST` for each
+  switch and each segment's set-up, so that a run of switches with few scan
+  steps between them (a contact bouncing as it settles) returns too;
 * ``DONE`` / ``CHATTER``: the run ended, at ``end_time`` or at the
   chattering guard (``max_events`` events, or endless switching at one
   instant).
@@ -72,6 +75,9 @@ from ._codes import (  # noqa: E402 - status codes and the carry's layout, share
 )
 
 KMAX = 5  # highest derivative used to judge a tangency
+# what a switch or a segment's set-up counts in the budget of a call, in scan steps: about their cost relative to a
+# step's (interpreted, 16 modes: ~3 ms against ~0.1 ms), so that a call returns after about the same time either way
+PASS_COST = 32
 ROW_MAIN, ROW_PHASE = 0, 1  # a contactor's switching row; the end of its released phase
 
 
@@ -362,6 +368,9 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
             ic[I_SAME] += 1
             if ic[I_NEV] >= max_events or ic[I_SAME] > 4 * nc + 8:
                 return CHATTER
+            evals += PASS_COST
+            if evals >= budget:
+                return CHECKPOINT
             continue
         t = fc[F_T]
         kp = ic[I_PIECE]
@@ -466,5 +475,6 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
                         for n in range(nm):
                             deta[n] += LW[s, 1, n] * du
                 ic[I_PIECE] = kp + 1
+        evals += PASS_COST
         if evals >= budget:
             return CHECKPOINT
