@@ -448,7 +448,7 @@ def test_a_switch_made_at_once_by_the_one_before_moves_with_its_instant():
     # saltation took that release as a crossing of its own function: multipliers 0.133 where the map's are
     # 0.0988, the Jacobian 0.73 off. The instant is set by the first switch; the whole jump moves with it.
     # Tolerance: measured 8.0e-8 at a step of 1e-5 (1.0e-7 at 1e-6: central differences' round-off); 1e-6
-    # leaves a factor 12. (A residual of 2.5e-6 was left until the switch undone at its instant, at 15.07 ms,
+    # leaves a factor 12. (A residual of 2.5e-6 was left until the switch undone at its instant, at 15.19 ms,
     # was restored: test_switches_undone_at_their_instant_are_in_the_jacobian.)
     raw = {"beam": {"length": 0.1092, "width": 0.00993, "height": 0.00303, "youngs_modulus": 1834e6,
                     "density": 951.98, "sections": [{"length": 0.04, "height": 0.004}, {"length": 0.0692}]},
