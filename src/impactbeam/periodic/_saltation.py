@@ -58,7 +58,7 @@ import numpy as np
 from ..solver._codes import TOUCH
 
 __all__ = ["FlowJacobian", "flow_jacobian", "segment_transition", "slot_transition", "to_free", "from_free",
-           "GRAZING"]
+           "energy_weights", "GRAZING"]
 
 #: An event whose normal velocity is below this fraction of the orbit's velocity scale is grazing:
 #: near a grazing contact the map grows like the square root of the penetration (its derivative
@@ -335,7 +335,8 @@ def _restored(fld: _Field, j: int, x: np.ndarray, recorded: list[int]) -> list[i
     sol, pk = fld.sol, fld.pk
     s, after = int(sol.slot[j]), int(sol.slot[j + 1])
     target = fld.end_state(j + 1, at_start=True)
-    tol = 1e-9 * max(float(np.linalg.norm(target)), np.finfo(float).tiny)
+    weights = energy_weights(pk.omo[after])
+    tol = 1e-9 * max(float(np.linalg.norm(weights * target)), np.finfo(float).tiny)
     slots = {int(m): i for i, m in reversed(list(enumerate(pk.smask[: pk.nslots])))}
 
     def lands(seq: list[int]) -> bool:
@@ -345,7 +346,7 @@ def _restored(fld: _Field, j: int, x: np.ndarray, recorded: list[int]) -> list[i
             if mask not in slots:  # a state the engine never entered
                 return False
             xp, sl = _block(_transfer(pk, slots[mask], sl)) @ xp, slots[mask]
-        return sl == after and float(np.linalg.norm(xp - target)) <= tol
+        return sl == after and float(np.linalg.norm(weights * (xp - target))) <= tol
 
     if lands(recorded):
         return recorded
@@ -356,6 +357,17 @@ def _restored(fld: _Field, j: int, x: np.ndarray, recorded: list[int]) -> list[i
             if lands(seq):
                 return seq
     return recorded
+
+
+def energy_weights(om: np.ndarray) -> np.ndarray:
+    """Weights of the energy norm ``|(omega eta, eta_t)|`` of a modal state with frequencies ``om``.
+
+    A rigid-body coordinate (``omega = 0``) takes the lowest positive frequency.
+    """
+    om = np.asarray(om, dtype=float)
+    positive = om[om > 0.0]
+    ref = float(positive.min()) if positive.size else 1.0
+    return np.concatenate([np.where(om > 0.0, om, ref), np.ones(om.size)])
 
 
 def _velocity_scale(sol) -> float:

@@ -41,7 +41,7 @@ import numpy as np
 
 from .._warnings import emit_user_level_warning
 from ..exceptions import ParameterError
-from ._saltation import FlowJacobian, flow_jacobian, to_free
+from ._saltation import FlowJacobian, energy_weights, flow_jacobian, to_free
 
 if TYPE_CHECKING:
     from ..scenario import Scenario
@@ -162,12 +162,8 @@ class StroboscopicMap:
         self.excitation = dataclasses.replace(exc, start=0.0, phase=float(exc.phase) + 2.0 * math.pi * self.phase)
         self.contactors = tuple(scenario.contactors)
         self.packed = pack(scenario.beam, self.contactors, scenario.damping, self.excitation, self.options)
-        n = self.packed.n_modes
-        om = np.asarray(self.packed.om[0], dtype=float)
-        positive = om[om > 0.0]
-        ref = float(positive.min()) if positive.size else 1.0
         #: weights of the energy norm |(omega eta, eta_t)|
-        self.weights = np.concatenate([np.where(om > 0.0, om, ref), np.ones(n)])
+        self.weights = energy_weights(self.packed.om[0])
 
     @property
     def size(self) -> int:
