@@ -522,7 +522,8 @@ _PHASED = {  # the paper's basis, 6 modes, three stops with dashpots (one by res
                    {"position_ratio": 0.76, "stiffness": 4173.03, "gap": 5e-05, "side": "above", "restitution": 0.3},
                    {"position_ratio": 0.554, "stiffness": 303213.9, "gap": 5e-05, "side": "above", "damping": 0.21954}],
     "damping": {"free": 0.02, "contact": 0.05},
-    "excitation": {"kind": "point_force", "shape": "harmonic", "amplitude": 0.2, "position": 0.06712, "frequency": 30.0},
+    "excitation": {"kind": "point_force", "shape": "harmonic", "amplitude": 0.2, "position": 0.06712,
+                   "frequency": 30.0},
     "solver": {"modes": 6, "end_time": 1.0, "basis": "paper"}}
 
 
@@ -559,6 +560,67 @@ def test_a_dashpot_released_phase_is_tracked_as_the_engine_does():
     jac, mu = _jacobian_error(_PHASED)
     assert jac < 1e-6
     assert mu < 1e-7  # measured 6.8e-10
+
+
+_COEXISTING = {  # a period-1 and a period-4 orbit, both stable: a simulation from rest settles on the second
+    "beam": {"length": 0.1092, "width": 0.00993, "height": 0.00303, "youngs_modulus": 1834e6, "density": 951.98},
+    "supports": {"left": {"translational": "inf", "rotational": 50.0}, "right": "free"},
+    "contactors": [{"position_ratio": 0.191, "stiffness": 1516.193, "gap": 1e-05, "side": "above"},
+                   {"position_ratio": 0.994, "stiffness": 900580.5, "gap": 1e-05, "side": "above", "damping": 0.20312}],
+    "damping": {"model": "free_modes", "free": 0.05},
+    "excitation": {"kind": "point_force", "shape": "harmonic", "amplitude": 0.05, "position": 0.05037,
+                   "frequency": 120.0, "phase": 0.7},
+    "solver": {"modes": 4, "end_time": 1.0}}
+
+
+def test_a_settled_response_of_another_period_is_said():
+    # Found by a random hunt (orbits against plain simulations): the simulation settles on a period-4 response,
+    # and Newton with multiple = 1 from its state converges, in 3 steps, to a coexisting stable period-1 orbit
+    # (its strobe 9 % of the amplitude off the simulation's), which was reported without a word. The settling
+    # run's own period is read now, and a multiple it does not divide is warned about.
+    sc = parse_scenario(_COEXISTING)
+    with pytest.warns(ImpactBeamWarning, match=r"the settling run repeats after 4 forcing period\(s\), not after "
+                                               r"multiple = 1"):
+        one = periodic_orbit(sc, settle_periods=120)
+    assert one.converged and one.stable and one.least_period == 1
+    assert any("repeats after 4" in w for w in one.warnings)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ImpactBeamWarning)  # the settled period: nothing to say
+        four = periodic_orbit(sc, settle_periods=120, multiple=4)
+    assert four.converged and four.stable and four.least_period == 4
+    # the period-4 orbit is the simulation's: a plain run from rest, 160 periods past the settling run, at the
+    # orbit's strobe times (measured 4.5e-12 of the amplitude: the transient decays as 0.33 per 4 periods)
+    T = 4 / 120.0
+    plain = ib.simulate(sc.with_values({"solver.end_time": float(four.strobe_times[-1] + 40 * T)}))
+    w = plain.displacement([sc.contactors[0].position], four.strobe_times + 40 * T)[0]
+    assert np.max(np.abs(w - four.strobe)) < 1e-9 * np.max(np.abs(four.strobe))
+    assert np.max(np.abs(w - one.strobe[0])) > 0.05 * np.max(np.abs(four.strobe))  # measured 0.091
+
+
+_PRELOADED = {  # a gravity-like preload (base acceleration 1 g) on a beam driven against two stops
+    "beam": {"length": 0.1092, "width": 0.00993, "height": 0.00303, "youngs_modulus": 1834e6, "density": 951.98},
+    "supports": {"left": {"translational": "inf", "rotational": 50.0}, "right": "pinned"},
+    "contactors": [{"position_ratio": 0.774, "stiffness": 58089.08, "gap": 5e-05, "side": "above"},
+                   {"position_ratio": 0.442, "stiffness": 121.2246, "gap": 5e-05, "side": "above", "damping": 0.27936}],
+    "damping": {"free": 0.01, "contact": 0.01},
+    "excitation": {"kind": "point_force", "shape": "harmonic", "amplitude": -1.0, "position": 0.0612,
+                   "frequency": 120.0, "phase": 0.7},
+    "preload": {"kind": "base_acceleration", "amplitude": 9.81},
+    "solver": {"modes": 6, "end_time": 1.0}}
+
+
+def test_the_map_carries_the_preload():
+    # Found by a random hunt (orbits against plain simulations): the stroboscopic map was built and run
+    # without the scenario's preload, so Newton found the orbit of another load: its strobe 2.5 % of the
+    # amplitude off the simulation's, multipliers of that other orbit, no warning. Against a plain run from rest
+    # (the transient decays as 0.67 per period over 300 periods past the settling run): measured 2.5e-13.
+    sc = parse_scenario(_PRELOADED)
+    orbit = periodic_orbit(sc, settle_periods=60)
+    assert orbit.converged and orbit.stable
+    T = 1 / 120.0
+    plain = ib.simulate(sc.with_values({"solver.end_time": float(orbit.strobe_times[-1] + 300 * T)}))
+    w = plain.displacement([sc.contactors[0].position], orbit.strobe_times + 300 * T)[0]
+    assert np.max(np.abs(w - orbit.strobe)) < 1e-9 * np.max(np.abs(w))
 
 
 def test_a_jacobian_that_is_not_finite_gives_no_multipliers_and_says_why(tmp_path, monkeypatch):

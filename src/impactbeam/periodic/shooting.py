@@ -161,7 +161,8 @@ class StroboscopicMap:
         # the load seen from the section: u(t_s + tau) = A sin(2 pi f tau + phase_0 + 2 pi phase)
         self.excitation = dataclasses.replace(exc, start=0.0, phase=float(exc.phase) + 2.0 * math.pi * self.phase)
         self.contactors = tuple(scenario.contactors)
-        self.packed = pack(scenario.beam, self.contactors, scenario.damping, self.excitation, self.options)
+        self.packed = pack(scenario.beam, self.contactors, scenario.damping, self.excitation, self.options,
+                           scenario.preload)
         #: weights of the energy norm |(omega eta, eta_t)|
         self.weights = energy_weights(self.packed.om[0])
 
@@ -186,7 +187,7 @@ class StroboscopicMap:
         n = self.packed.n_modes
         sc = self.scenario
         return integrate(sc.beam, self.contactors, sc.damping, self.excitation, InitialCondition(), opt,
-                         start=(x[:n].copy(), x[n:].copy()))
+                         start=(x[:n].copy(), x[n:].copy()), preload=sc.preload)
 
     def _checked(self, x: np.ndarray) -> Solution:
         from ..exceptions import SimulationError
@@ -368,7 +369,35 @@ def periodic_orbit(
         smp = sol.sample(np.array([scenario.beam.length]), np.array([t_s]), modal=True)
         j = int(sol.segment_index(np.array([t_s]))[0])
         x = to_free(sol.packed, int(sol.slot[j])) @ np.concatenate([smp.eta[0], smp.eta_t[0]])
+        settled = _settled_period(sol, scenario, end)
+        if settled and M % settled:
+            notes = (f"periodic orbit: the settling run repeats after {settled} forcing period(s), not after "
+                     f"multiple = {M}: an orbit found from its state is another one than the simulation settles on "
+                     f"(they coexist); multiple = {settled} looks for the settled one",)
+            return _newton(scenario, pmap, x, k0, tolerance, max_iterations, notes)
     return _newton(scenario, pmap, x, k0, tolerance, max_iterations)
+
+
+#: Forcing periods at the end of the settling run whose strobe :func:`_settled_period` reads.
+_SETTLED_RECORD = 24
+
+
+def _settled_period(sol: Solution, scenario: Scenario, end: float) -> int:
+    """Period, in forcing periods, of the settling run's strobe over its last periods; 0 when none is found.
+
+    The strobe samples and the period test of :mod:`~impactbeam.periodic.strobe`, on the last
+    :data:`_SETTLED_RECORD` periods (fewer when the run is shorter; none below four).
+    """
+    from .strobe import PERIOD_TOLERANCE, detect_period, strobe_samples
+
+    exc = scenario.excitation
+    f = float(exc.frequency)
+    done = int(math.floor(f * (end - exc.start) + 1e-9))
+    n = min(done, _SETTLED_RECORD)
+    if n < 4:
+        return 0
+    times = exc.start + np.arange(done - n, done + 1) / f
+    return detect_period(strobe_samples(sol, scenario, times)[1], PERIOD_TOLERANCE, n // 2)[0]
 
 
 def _residual(pmap: StroboscopicMap, x: np.ndarray, fj: FlowJacobian) -> float:
@@ -391,7 +420,8 @@ _NOT_FINITE = ("the map's Jacobian is not finite at this state (a saltation divi
                "which is zero at a grazing contact)")
 
 
-def _newton(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, k0: int, tol: float, max_it: int) -> PeriodicOrbit:
+def _newton(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, k0: int, tol: float, max_it: int,
+            notes: tuple[str, ...] = ()) -> PeriodicOrbit:
     """Newton's iteration on ``P(x) = x``; the orbit.
 
     A step that does not lower the residual is halved up to ``_MAX_BACKTRACK``
@@ -432,7 +462,7 @@ def _newton(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, k0: int, t
         x, fj, res = x + lam * dx, fj_new, res_new
         residuals.append(res)
         it += 1
-    return _report(scenario, pmap, x, fj, k0, it, tuple(residuals), tol, stalled)
+    return _report(scenario, pmap, x, fj, k0, it, tuple(residuals), tol, stalled, notes)
 
 
 def _least_period(pmap: StroboscopicMap, sol: Solution, x: np.ndarray) -> int:
@@ -452,11 +482,11 @@ def _least_period(pmap: StroboscopicMap, sol: Solution, x: np.ndarray) -> int:
 
 
 def _report(scenario: Scenario, pmap: StroboscopicMap, x: np.ndarray, fj: FlowJacobian, k0: int, it: int,
-            residuals: tuple[float, ...], tol: float, stalled: str = "") -> PeriodicOrbit:
+            residuals: tuple[float, ...], tol: float, stalled: str = "", before: tuple[str, ...] = ()) -> PeriodicOrbit:
     exc = scenario.excitation
     f, M = pmap.frequency, pmap.multiple
     converged = residuals[-1] <= tol
-    notes: list[str] = []
+    notes: list[str] = list(before)
     if not converged:
         notes.append(
             f"periodic orbit: Newton did not converge in {it} iteration(s) (relative residual {residuals[-1]:.3g} "

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from ..solver.solution import ModalState
 
 __all__ = ["SteadyState", "steady_state", "analyse_steady_state", "detect_period", "strobe_point",
-           "harmonic_period"]
+           "harmonic_period", "strobe_samples"]
 
 #: Default relative tolerance of the period test (see the module docstring).
 PERIOD_TOLERANCE = 1e-4
@@ -215,6 +215,13 @@ def _probes(length: float, contactors: tuple[float, ...], outputs: tuple[float, 
     return out
 
 
+def strobe_samples(sol: Any, scenario: Scenario, times: np.ndarray) -> tuple[Any, np.ndarray]:
+    """The solution at the probe points at ``times`` (:meth:`~impactbeam.solver.solution.Solution.sample`)
+    and those samples as :func:`detect_period` takes them (displacements and velocities, each scaled)."""
+    smp = sol.sample(_probe_points(scenario), times)
+    return smp, _scaled(smp.w, smp.w_t)
+
+
 def _scaled(w: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Displacements and velocities each divided by the largest magnitude of their group."""
     sw = float(np.max(np.abs(w))) or 1.0
@@ -305,14 +312,13 @@ def _record_analysis(result: SimulationResult, scenario: Scenario, settle_period
     k = np.arange(settle_periods, settle_periods + record_periods + 1)
     times = np.minimum(t_load + k * T, sol.t_end)
     probes = _probe_points(scenario)
-    smp = sol.sample(probes, times)
+    smp, scaled = strobe_samples(sol, scenario, times)
     x0 = strobe_point(scenario)
     j0 = int(np.searchsorted(probes, x0))  # one of the probes: its samples are the strobe's
     lo, hi = float(times[0]), float(times[-1])
     warns: list[str] = []
     if result.status != 0:
         warns.append(f"the run stopped early ({result.message}); the steady state is incomplete")
-    scaled = _scaled(smp.w, smp.w_t)
     n, mism = detect_period(scaled, tolerance, max_period)
     before = settle_periods if settled_after is None else settled_after
     settling = still_settling(scaled, n, tolerance)
