@@ -227,24 +227,28 @@ def _check(scenario: Scenario, multiple: Any) -> int:
     return int(multiple)
 
 
-def _section_phase(sol: Any, lo: float, hi: float, start: float, f: float, prefer_free: bool) -> float:
-    """Phase (fraction of the forcing period) of the middle of the longest event-free interval in ``[lo, hi]``.
+def _section_phase(sol: Any, lo: float, hi: float, start: float, f: float,
+                   prefer_free: bool) -> tuple[float, bool]:
+    """Phase (fraction of the forcing period) of the middle of the longest event-free interval in ``[lo, hi]``,
+    and whether that interval is free.
 
     With ``prefer_free`` only intervals of the free state count when there are any. An interval where a
-    contactor with a dashpot is released but still compressed (its released phase) does not count as
-    free: the map's state (the modal coordinates) cannot tell that phase from an engaged contact.
+    contactor is pressed into its stop while released does not count as free: a dashpot contactor in its
+    released phase (the map's state, the modal coordinates, cannot tell it from an engaged contact), or,
+    with the paper's basis, one a projection left on the wrong side until it turns back (a run started
+    there would switch it at once).
     """
     times = [lo] + [ev.time for ev in sol.events if lo < ev.time < hi] + [hi]
     best, best_len, best_free = 0.5 * (lo + hi), -1.0, False
-    dashed = [i for i in range(len(sol.contactors)) if sol.dashpots[i] > 0.0]
+    every = list(range(len(sol.contactors)))
     for a, b in zip(times[:-1], times[1:]):
         mid = 0.5 * (a + b)
         j = int(sol.segment_index(np.array([mid]))[0])
-        free = sol.engaged(j) == () and not _compressed(sol, dashed, mid)
+        free = sol.engaged(j) == () and not _compressed(sol, every, mid)
         key_better = (free and not best_free) if prefer_free else False
         if key_better or ((free == best_free or not prefer_free) and b - a > best_len):
             best, best_len, best_free = mid, b - a, free
-    return float((f * (best - start)) % 1.0)
+    return float((f * (best - start)) % 1.0), best_free
 
 
 def _compressed(sol: Any, which: list[int], t: float) -> bool:
@@ -362,19 +366,26 @@ def periodic_orbit(
 
         # per-state modes (solver.basis = "paper", or a beam that can move as a rigid body)
         prefer_free = not isinstance(sol.packed.space, RitzStateSpace) or bool(np.any(sol.packed.dash > 0.0))
-        phase = _section_phase(sol, end - M / f, end, float(exc.start), f, prefer_free)
+        phase, free = _section_phase(sol, end - M / f, end, float(exc.start), f, prefer_free)
         pmap = StroboscopicMap(scenario, M, phase, n_modes)
         k0 = math.ceil(f * (end - exc.start) - M - phase - 1e-9)
         t_s = exc.start + (k0 + phase) / f
         smp = sol.sample(np.array([scenario.beam.length]), np.array([t_s]), modal=True)
         j = int(sol.segment_index(np.array([t_s]))[0])
         x = to_free(sol.packed, int(sol.slot[j])) @ np.concatenate([smp.eta[0], smp.eta_t[0]])
+        notes = []
+        if prefer_free and not free:
+            notes.append(f"periodic orbit: the settling run has no free flight in its last {M} forcing period(s), "
+                         "so the section lies inside a contact, where the map's start (modal coordinates of the "
+                         "free state) loses what the paper's per-state modes or a dashpot's released phase carry: "
+                         "the orbit and its multipliers are those of that map, which may differ slightly from the "
+                         "simulation's (1e-6 of the amplitude in the cases seen)")
         settled = _settled_period(sol, scenario, end)
         if settled and M % settled:
-            notes = (f"periodic orbit: the settling run repeats after {settled} forcing period(s), not after "
-                     f"multiple = {M}: an orbit found from its state is another one than the simulation settles on "
-                     f"(they coexist); multiple = {settled} looks for the settled one",)
-            return _newton(scenario, pmap, x, k0, tolerance, max_iterations, notes)
+            notes.append(f"periodic orbit: the settling run repeats after {settled} forcing period(s), not after "
+                         f"multiple = {M}: an orbit found from its state is another one than the simulation settles "
+                         f"on (they coexist); multiple = {settled} looks for the settled one")
+        return _newton(scenario, pmap, x, k0, tolerance, max_iterations, tuple(notes))
     return _newton(scenario, pmap, x, k0, tolerance, max_iterations)
 
 
