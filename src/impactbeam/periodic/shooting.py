@@ -373,8 +373,10 @@ def periodic_orbit(
         smp = sol.sample(np.array([scenario.beam.length]), np.array([t_s]), modal=True)
         j = int(sol.segment_index(np.array([t_s]))[0])
         x = to_free(sol.packed, int(sol.slot[j])) @ np.concatenate([smp.eta[0], smp.eta_t[0]])
-        notes = []
-        if prefer_free and not free:
+        notes: list[str] = []
+        released = [i for i in range(len(scenario.contactors)) if i not in sol.engaged(j)]
+        per_state = not isinstance(sol.packed.space, RitzStateSpace)
+        if not free and (per_state or _compressed(sol, released, t_s)):  # (the shared basis: exact in contact)
             notes.append(f"periodic orbit: the settling run has no free flight in its last {M} forcing period(s), "
                          "so the section lies inside a contact, where the map's start (modal coordinates of the "
                          "free state) loses what the paper's per-state modes or a dashpot's released phase carry: "
