@@ -192,7 +192,9 @@ def touch_scale_warning(rows: tuple, length: float) -> str | None:
     makes a sequence of impacts without end in theory; the engine follows it
     down to the touch tolerance, so the impacts of its tail, each at most
     :data:`TOUCH_SCALE` touch tolerances deep, are as many as that tolerance
-    makes them. ``rows`` as :meth:`~impactbeam.solver.solution.Solution.metric_arrays`
+    makes them. With the paper's basis, a struck contactor the projection of
+    eq. (12) leaves on the wrong side makes contacts that never press the
+    stop at all. ``rows`` as :meth:`~impactbeam.solver.solution.Solution.metric_arrays`
     returns them with the table.
     """
     from ..solver._codes import TOUCH
@@ -207,10 +209,11 @@ def touch_scale_warning(rows: tuple, length: float) -> str | None:
     return (
         f"metrics: {n} of {rc.size} impacts (contactor {which}, between t = {start[shallow].min():.6g} and "
         f"{start[shallow].max():.6g} s) are at most {depth:.2g} m deep ({TOUCH_SCALE} touch tolerances; peak force "
-        f"at most {np.nanmax(force[shallow]):.2g} N), resolved only at the scale of the touch tolerance (1e-12 of "
-        "the beam length): a contact bouncing with ever smaller rebounds as it settles onto its stop (a dashpot or "
-        "restitution stop at a small gap) makes such impacts without end, as many as that tolerance resolves; "
-        "n_impacts and the impact table count them"
+        f"at most {np.nanmax(force[shallow]):.2g} N), contacts resolved only at the scale of the touch tolerance "
+        "(1e-12 of the beam length): a contact settling onto its stop by ever smaller bounces (a dashpot or "
+        "restitution stop at a small gap) makes such impacts without end, as many as that tolerance resolves, and "
+        "with the paper's basis a projection can leave a struck contactor on the wrong side (see the projection's "
+        "warning); n_impacts and the impact table count them"
     )
 
 
