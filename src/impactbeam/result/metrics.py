@@ -38,7 +38,8 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
     from ..model.beam import Contactor
 
-__all__ = ["compute_metrics", "contact_forces", "contact_intervals", "response_point", "METRIC_UNITS", "METRIC_DISPLAY"]
+__all__ = ["compute_metrics", "contact_forces", "contact_intervals", "response_point", "per_state", "pushing_parts",
+           "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
 METRIC_UNITS = {
@@ -169,6 +170,8 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     else:
         out["events"] = [{"time": e.time, "kind": e.kind, "contactor": e.contactor} for e in result.events]
     if impacts:
+        if np.isfinite(scalars[0]):
+            _clip_pulling(result, rows[0], rows[1], rows[3], rows[5], rows[6])
         out["impacts"] = _impact_table(result, rows) if np.isfinite(scalars[0]) else []
         text = touch_scale_warning(rows, result.beam.length) if out["impacts"] else None
         if text is not None:
@@ -176,6 +179,69 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
 
             emit_user_level_warning(text)
     return out
+
+
+def per_state(result: ResultLike) -> bool:
+    """Whether the run's states have their own modes (the paper's basis, or a beam free to move as a rigid
+    body), whose switches move the state by the projection of eq. (12)."""
+    from ..solver.ritz_space import RitzStateSpace
+
+    sol = result.solution  # the exact solution's packed problem, or the solve_ivp path's integrator
+    space = getattr(getattr(sol, "packed", None), "space", None) or getattr(getattr(sol, "ref", None), "space", None)
+    return space is not None and not isinstance(space, RitzStateSpace)
+
+
+def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple[float, float]]:
+    """The parts of the contact ``[a, b]`` of contactor ``ci`` where its force ``k d + c_d d'`` pushes.
+
+    Split at the segments' ends (with per-state modes the state jumps there) and at the force's sign
+    changes, located on 4001 points of the contact, then by Brent's method; a part keeps its own ends.
+    """
+    from scipy.optimize import brentq
+
+    sol = result.solution
+    c = result.contactors[ci]
+    r = float(getattr(sol, "dashpots", np.zeros(ci + 1))[ci]) / c.stiffness
+
+    def g(t: Any) -> np.ndarray:  # F / k
+        smp = sol.sample(np.array([c.position]), np.atleast_1d(np.asarray(t, dtype=float)))
+        return c.direction * (smp.w[:, 0] + r * smp.w_t[:, 0]) - c.gap
+
+    edges = np.array([a] + [float(t) for t in sol.segment_starts if a < t < b] + [b])
+    t = np.linspace(a, float(np.nextafter(b, -np.inf)), 4001)  # (a sample at b is of the next segment)
+    v = g(t)
+    roots = [brentq(lambda x: float(g(x)[0]), t[j], t[j + 1], xtol=1e-15 * max(abs(b), 1e-300))
+             for j in np.flatnonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0.0)
+             if not np.any((edges > t[j]) & (edges <= t[j + 1]))]  # a jump at a segment's end is not a root
+    ends = np.unique(np.concatenate([edges, roots]))
+    return [(float(u), float(w)) for u, w in zip(ends[:-1], ends[1:]) if g(0.5 * (u + w))[0] > 0.0]
+
+
+def _clip_pulling(result: ResultLike, rc: np.ndarray, ra: np.ndarray, rbe: np.ndarray, force: np.ndarray,
+                  impulse: np.ndarray) -> None:
+    """Impulses of contacts with per-state modes: the integral of the force's positive part, segment by segment.
+
+    The contact force never pulls (:meth:`~impactbeam.model.beam.Contactor.force`). With the shared basis an
+    engaged contactor's force stays positive until its release and the state is continuous, so the table's
+    closed form ``k int d dt + c_d [d]`` is its integral. With per-state modes (:func:`per_state`) every
+    switch moves the state, and can leave a struck contactor on the wrong side: the impulse is summed over
+    the parts where the force pushes (:func:`pushing_parts`), the dashpot's share ``c_d [d]`` within each
+    (from the left of its end); a contact that never pushes gets 0. Contact ``i``: contactor ``rc[i]`` on
+    ``[ra[i], rbe[i]]``, its peak force ``force[i]``; ``impulse`` is changed in place.
+    """
+    if not rc.size or not per_state(result):
+        return
+    sol = result.solution
+    dash = getattr(sol, "dashpots", np.zeros(len(result.contactors)))
+    for i in range(rc.size):
+        total = 0.0
+        c, cd = result.contactors[int(rc[i])], float(dash[int(rc[i])])
+        for u, w in pushing_parts(result, int(rc[i]), float(ra[i]), float(rbe[i])) if force[i] > 0.0 else []:
+            total += c.stiffness * (c.direction * sol.integrals([(c.position, u, w)])[0] - c.gap * (w - u))
+            if cd > 0.0:  # c_d [d], the part's end from the left
+                wl = sol.sample(np.array([c.position]), np.array([u, float(np.nextafter(w, -np.inf))])).w[:, 0]
+                total += cd * c.direction * (wl[1] - wl[0])
+        impulse[i] = max(total, 0.0)
 
 
 #: An impact whose peak compression is at most this many touch tolerances (the engine's 1e-12 of the beam's
@@ -345,14 +411,18 @@ def contact_forces(result: ResultLike, intervals: Sequence[tuple[int, float, flo
     forced = np.flatnonzero(rate > 0.0)
     if forced.size:  # the compressions at the ends, for the dashpot's share c [d]: one evaluation for all
         xs = np.unique([cs[i].position for i in forced])
-        ts = np.array([t for i in forced for t in intervals[i][1:]])
+        # the end from the left: a sample at an event time is of the segment it starts (after the switch's
+        # projection, which with per-state modes moves the state)
+        ts = np.array([t for i in forced for t in (intervals[i][1], np.nextafter(intervals[i][2], -np.inf))])
         w = sol.sample(xs, ts).w
         col = np.searchsorted(xs, [cs[i].position for i in forced])
         for j, i in enumerate(forced):
             d0[i], d1[i] = cs[i].direction * w[2 * j: 2 * j + 2, col[j]] - cs[i].gap
     ci, a, b = (np.array(v) for v in zip(*intervals))
-    return _forces(result, ci.astype(np.int64), a.astype(float), b.astype(float), peaks, np.asarray(ints, dtype=float),
-                   d0, d1)
+    force, impulse = _forces(result, ci.astype(np.int64), a.astype(float), b.astype(float), peaks,
+                             np.asarray(ints, dtype=float), d0, d1)
+    _clip_pulling(result, ci.astype(np.int64), a.astype(float), b.astype(float), force, impulse)
+    return force, impulse
 
 
 def _forces(result: ResultLike, contactor: np.ndarray, start: np.ndarray, end: np.ndarray, peaks: np.ndarray,

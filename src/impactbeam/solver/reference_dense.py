@@ -83,6 +83,11 @@ class IvpSolution(PiecewiseSolution):
         self._t0 = np.array([seg.t0 for seg in segments])
         self._h = ref.max_step / 8.0
 
+    @property
+    def segment_starts(self) -> np.ndarray:
+        """Start times of the segments (the states between events) [s]."""
+        return self._t0
+
     def _index(self, t: np.ndarray) -> np.ndarray:
         return np.clip(np.searchsorted(self._t0, t, side="right") - 1, 0, len(self.segments) - 1)
 

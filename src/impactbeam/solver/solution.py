@@ -363,6 +363,11 @@ class Solution(PiecewiseSolution):
     def n_segments(self) -> int:
         return int(self.t0.size)
 
+    @property
+    def segment_starts(self) -> np.ndarray:
+        """Start times of the segments [s] (``t0``)."""
+        return self.t0
+
     def engaged(self, j: int) -> tuple[int, ...]:
         """Engaged contactors of segment ``j``.
 

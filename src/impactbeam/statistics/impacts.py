@@ -28,7 +28,8 @@ The contact force is :meth:`~impactbeam.model.beam.Contactor.force`,
 impulses are those of the result's impact table
 (:func:`~impactbeam.result.metrics.contact_forces`). ``F^2`` and
 ``|F v|`` are integrated by Gauss-Legendre quadrature on each side of the
-deepest compression (where ``|F v|`` has its kink), with panels of one
+deepest compression (where ``|F v|`` has its kink), of every segment and, with per-state modes, where the
+force changes sign (:func:`~impactbeam.result.metrics.pushing_parts`), with panels of one
 period of the highest retained frequency and 8 nodes each: exact for
 polynomials of degree 15, so within 1e-5 for a sinusoid at that frequency
 (``pi^16 / 16!``) and much closer for the lower modes that carry the force.
@@ -42,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from ..result.metrics import contact_forces
+from ..result.metrics import contact_forces, per_state, pushing_parts
 from .window import analysis_window, top_frequency
 
 __all__ = ["ImpactStatistics", "impact_statistics", "IMPACT_UNITS"]
@@ -139,7 +140,16 @@ def _contactor(result: Any, ci: int, lo: float, hi: float, panel: float) -> tupl
         b = np.array([r[1] for r in clipped])
         ext = sol.extrema([(c.position, ai, bi, s, -s * c.gap, ci) for ai, bi in zip(a, b)])
         tp = np.clip(np.nan_to_num(ext[:, 1], nan=0.5 * (a + b)), a, b)
-        nodes, weights = _gauss(np.concatenate([a, tp]), np.concatenate([tp, b]), panel)
+        # panels end at the deepest compression and at the segments' ends (with per-state modes the state
+        # jumps there, by the projection of eq. 12)
+        starts = np.asarray(sol.segment_starts)
+        cuts = np.unique(np.concatenate([a, tp, b, starts[(starts > a.min()) & (starts < b.max())]]))
+        if per_state(result):  # and where a projection left the force pulling: its sign changes
+            cuts = np.unique(np.concatenate([cuts] + [np.ravel(pushing_parts(result, ci, ai, bi))
+                                                      for ai, bi in zip(a, b)]))
+        inside = [cuts[(cuts >= ai) & (cuts <= bi)] for ai, bi in zip(a, b)]
+        nodes, weights = _gauss(np.concatenate([e[:-1] for e in inside]), np.concatenate([e[1:] for e in inside]),
+                                panel)
         smp = sol.sample(np.array([c.position]), nodes)
         force = c.force(smp.w[:, 0], smp.w_t[:, 0], dash)
         f2 = float(np.sum(weights * force**2))
