@@ -195,7 +195,7 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
     """The parts of the contact ``[a, b]`` of contactor ``ci`` where its force ``k d + c_d d'`` pushes.
 
     Split at the segments' ends (with per-state modes the state jumps there) and at the force's sign
-    changes, located on 4001 points of the contact, then by Brent's method; a part keeps its own ends.
+    changes, located on 513 points of the contact, then by Brent's method; a part keeps its own ends.
     """
     from scipy.optimize import brentq
 
@@ -208,7 +208,7 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
         return c.direction * (smp.w[:, 0] + r * smp.w_t[:, 0]) - c.gap
 
     edges = np.array([a] + [float(t) for t in sol.segment_starts if a < t < b] + [b])
-    t = np.linspace(a, float(np.nextafter(b, -np.inf)), 4001)  # (a sample at b is of the next segment)
+    t = np.linspace(a, float(np.nextafter(b, -np.inf)), 513)  # (a sample at b is of the next segment)
     v = g(t)
     roots = [brentq(lambda x: float(g(x)[0]), t[j], t[j + 1], xtol=1e-15 * max(abs(b), 1e-300))
              for j in np.flatnonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0.0)
