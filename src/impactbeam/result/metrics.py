@@ -183,7 +183,13 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
 
 def per_state(result: ResultLike) -> bool:
     """Whether the run's states have their own modes (the paper's basis, or a beam free to move as a rigid
-    body), whose switches move the state by the projection of eq. (12)."""
+    body), whose switches move the state by the projection of eq. (12).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        Of the exact engine or of the ``solve_ivp`` path.
+    """
     from ..solver.ritz_space import RitzStateSpace
 
     sol = result.solution  # the exact solution's packed problem, or the solve_ivp path's integrator
@@ -196,6 +202,19 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
 
     Split at the segments' ends (with per-state modes the state jumps there) and at the force's sign
     changes, located on 513 points of the contact, then by Brent's method; a part keeps its own ends.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    ci : int
+        The contactor.
+    a, b : float, [s]
+        The contact's start and end.
+
+    Returns
+    -------
+    list of (float, float)
+        The parts ``(start, end)`` [s] where the force is positive, in order.
     """
     from scipy.optimize import brentq
 
@@ -210,9 +229,14 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
     edges = np.array([a] + [float(t) for t in sol.segment_starts if a < t < b] + [b])
     t = np.linspace(a, float(np.nextafter(b, -np.inf)), 513)  # (a sample at b is of the next segment)
     v = g(t)
-    roots = [brentq(lambda x: float(g(x)[0]), t[j], t[j + 1], xtol=1e-15 * max(abs(b), 1e-300))
-             for j in np.flatnonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0.0)
-             if not np.any((edges > t[j]) & (edges <= t[j + 1]))]  # a jump at a segment's end is not a root
+    roots = []
+    for j in np.flatnonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0.0):
+        if np.any((edges > t[j]) & (edges <= t[j + 1])):
+            continue  # a jump at a segment's end is not a root
+        try:
+            roots.append(brentq(lambda x: float(g(x)[0]), t[j], t[j + 1], xtol=1e-15 * max(abs(b), 1e-300)))
+        except ValueError:  # the ends' signs differ only in the last bits of a vectorised sample: no root
+            continue
     ends = np.unique(np.concatenate([edges, roots]))
     return [(float(u), float(w)) for u, w in zip(ends[:-1], ends[1:]) if g(0.5 * (u + w))[0] > 0.0]
 
