@@ -139,11 +139,15 @@ def _transfer(pk, to: int, frm: int) -> np.ndarray:
     return np.asarray(pk.space.transfer(pk.keys[to], pk.keys[frm], pk.preserve), dtype=float)
 
 
-def _slot_of(pk, mask: int) -> int:
+def _built_slot(pk, mask: int) -> int | None:
+    """The slot of the state with engaged-contactor mask ``mask``, or None when it is not built."""
     hits = np.flatnonzero(pk.smask[: pk.nslots] == mask)
-    if hits.size:
-        return int(hits[0])
-    return int(pk.add_state(mask))
+    return int(hits[0]) if hits.size else None
+
+
+def _slot_of(pk, mask: int) -> int:
+    slot = _built_slot(pk, mask)
+    return int(pk.add_state(mask)) if slot is None else slot
 
 
 def to_free(pk, slot: int) -> np.ndarray:
@@ -326,26 +330,31 @@ def _restored(fld: _Field, j: int, x: np.ndarray, recorded: list[int]) -> list[i
 
     The engine records a switch of a contactor followed at the same instant
     by its undoing as no event (they cancel: :func:`~impactbeam.solver._loop._switch`).
-    With the shared basis the pair changes nothing; with the paper's
-    per-state modes its two projections (paper eq. 12) move the state. The
+    With the shared basis the pair changes nothing (the recorded switches
+    are returned as they are); with per-state modes its two projections
+    (paper eq. 12) move the state. The
     switches are those whose projections carry ``x`` (the end of segment
     ``j``) to the start of segment ``j + 1`` (to 1e-9 of its norm): the
     recorded ones, else with one or two pairs ``(c, c)`` inserted.
     """
+    from ..solver.ritz_space import RitzStateSpace
+
     sol, pk = fld.sol, fld.pk
+    if isinstance(pk.space, RitzStateSpace):  # exact changes of basis: a pair is no jump at all
+        return recorded
     s, after = int(sol.slot[j]), int(sol.slot[j + 1])
     target = fld.end_state(j + 1, at_start=True)
     weights = energy_weights(pk.omo[after])
     tol = 1e-9 * max(float(np.linalg.norm(weights * target)), np.finfo(float).tiny)
-    slots = {int(m): i for i, m in reversed(list(enumerate(pk.smask[: pk.nslots])))}
 
     def lands(seq: list[int]) -> bool:
         xp, sl, mask = x, s, int(pk.smask[s])
         for c in seq:
             mask ^= 1 << c
-            if mask not in slots:  # a state the engine never entered
+            nxt = _built_slot(pk, mask)
+            if nxt is None:  # a state the engine never entered
                 return False
-            xp, sl = _block(_transfer(pk, slots[mask], sl)) @ xp, slots[mask]
+            xp, sl = _block(_transfer(pk, nxt, sl)) @ xp, nxt
         return sl == after and float(np.linalg.norm(weights * (xp - target))) <= tol
 
     if lands(recorded):

@@ -219,6 +219,9 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
     from scipy.optimize import brentq
 
     sol = result.solution
+    known = sol.__dict__.setdefault("_pushing_parts", {})  # a solution does not change: the table and the
+    if (ci, a, b) in known:                                  # statistics ask for the same contacts
+        return known[(ci, a, b)]
     c = result.contactors[ci]
     r = float(getattr(sol, "dashpots", np.zeros(ci + 1))[ci]) / c.stiffness
 
@@ -238,7 +241,8 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
         except ValueError:  # the ends' signs differ only in the last bits of a vectorised sample: no root
             continue
     ends = np.unique(np.concatenate([edges, roots]))
-    return [(float(u), float(w)) for u, w in zip(ends[:-1], ends[1:]) if g(0.5 * (u + w))[0] > 0.0]
+    known[(ci, a, b)] = [(float(u), float(w)) for u, w in zip(ends[:-1], ends[1:]) if g(0.5 * (u + w))[0] > 0.0]
+    return known[(ci, a, b)]
 
 
 def _clip_pulling(result: ResultLike, rc: np.ndarray, ra: np.ndarray, rbe: np.ndarray, force: np.ndarray,
