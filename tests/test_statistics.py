@@ -45,6 +45,14 @@ def test_rainflow_counts_of_astm_e1049_example():
     assert got == {3.0: 0.5, 4.0: 1.5, 6.0: 0.5, 8.0: 1.0, 9.0: 0.5}
 
 
+def test_rainflow_of_a_monotone_record_is_one_half_cycle():
+    # ASTM E1049-85 5.4.4: the ranges left at the end count one half each; a point inside the ramp changes nothing
+    for series in ([0.0, 5.0], [0.0, 2.0, 5.0], [5.0, 0.0]):
+        rng, mean, count = rainflow_cycles(series)
+        assert (rng.tolist(), mean.tolist(), count.tolist()) == ([5.0], [2.5], [0.5])
+    assert all(a.size == 0 for a in rainflow_cycles([1.0, 1.0]))
+
+
 def test_basquin_endurance_and_goodman_by_hand():
     spec = FatigueSpec(points=(0.0,), sn_stress=100e6, sn_cycles=1e6, sn_exponent=5.0, endurance_limit=40e6,
                        mean_stress="goodman", ultimate_strength=400e6)
@@ -94,6 +102,12 @@ def test_harmonic_miner_damage_is_f_over_n():
         assert row["damage"] == pytest.approx(k / n_s, rel=1e-9)
         assert row["damage_rate"] == pytest.approx(f / n_s, rel=1e-9)
         assert row["life"] == pytest.approx(n_s / f, rel=1e-9)
+        # from the peak over 0.4 period the stress falls monotonically to amp cos(0.8 pi): the window's two
+        # ends are its only turning points, one half cycle (ASTM E1049-85 5.4.4; none before the fix)
+        row = fatigue_statistics(res, sc.fatigue, window=(tp, tp + 0.4 / f))[sc.fatigue.points.index(x)]
+        half = 0.5 * amp * (1.0 - math.cos(0.8 * math.pi))
+        assert row["cycles"] == 0.5
+        assert row["damage"] == pytest.approx(0.5 / (1e5 * (half / 2e6) ** -8), rel=1e-9)
 
 
 

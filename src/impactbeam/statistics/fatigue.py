@@ -166,7 +166,10 @@ def rainflow_cycles(series: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     """
     import rainflow
 
-    cyc = list(rainflow.extract_cycles(np.asarray(series, dtype=float).tolist()))
+    s = np.asarray(series, dtype=float).ravel()
+    if s.size == 2 and s[0] != s[1]:  # a monotone record: one half cycle (rainflow 3.2 yields none for two points)
+        return np.array([abs(s[1] - s[0])]), np.array([0.5 * (s[0] + s[1])]), np.array([0.5])
+    cyc = list(rainflow.extract_cycles(s.tolist()))
     if not cyc:
         return np.zeros(0), np.zeros(0), np.zeros(0)
     arr = np.array([c[:3] for c in cyc], dtype=float)
