@@ -37,6 +37,7 @@ import numpy as np
 from ..modal import static_moment
 from .._warnings import emit_user_level_warning
 from ..exceptions import ImpactBeamWarning
+from .timegrid import SAMPLES_PER_PERIOD, scan_times
 
 if TYPE_CHECKING:
     from .protocol import ResultLike
@@ -171,21 +172,20 @@ def bending_stress(
     return M * factor[:, None]
 
 
-#: Samples per period of the highest retained frequency in the time scan of :func:`max_bending_stress`.
-SAMPLES_PER_PERIOD = 8
-
-
 def max_bending_stress(result: ResultLike, *, points: int = 201) -> tuple[float, float, float]:
     """Largest ``|sigma|`` over the run: ``(value [Pa], time [s], position [m])``.
 
-    Independent of the output step: the exact solution is scanned at
-    ``SAMPLES_PER_PERIOD`` points per period of the highest retained frequency
-    (and at every event) on ``points`` positions plus the ends, the contactors
-    and a point load, then the best sample is refined by golden-section search
-    in time and in position on the exact solution. The result is the maximum
-    of the N-mode moment to the refinement's tolerance (1e-10 of the scan step
-    in time, 1e-9 L in position); a peak narrower than the scan step could be
-    missed, which the sampling density makes unlikely for a band-limited modal sum.
+    Independent of the output step: the exact solution is scanned on the
+    grid of :func:`~impactbeam.result.timegrid.scan_times`
+    (``SAMPLES_PER_PERIOD`` points per period of the visited states' highest
+    frequency, every event and break of the load, graded after them when a
+    state decays faster than that) on ``points`` positions plus the ends, the
+    contactors and a point load, then the best sample is refined by
+    golden-section search between its neighbours in time and in position on
+    the exact solution. The result is the maximum of the N-mode moment to the
+    refinement's tolerance (1e-10 of the bracket in time, 1e-9 L in
+    position); a peak narrower than the scan step could be missed, which the
+    grid makes unlikely for a sum of the retained coordinates.
 
     Parameters
     ----------
@@ -200,16 +200,13 @@ def max_bending_stress(result: ResultLike, *, points: int = 201) -> tuple[float,
     """
     sol, beam = result.solution, result.beam
     L, t_end = beam.length, sol.t_end
-    omega = float(np.max(sol.packed.space.state(()).modes.omega))
-    dt = 2.0 * np.pi / max(omega, 1e-300) / SAMPLES_PER_PERIOD
-    n = max(int(np.ceil(t_end / dt)), 1)
-    t = np.unique(np.concatenate([np.linspace(0.0, t_end, n + 1), [e.time for e in result.events if e.time <= t_end]]))
+    t = scan_times(result, 0.0, t_end)
     extra = [c.position for c in result.contactors]
     excitation = sol.packed.space.excitation
     if excitation.kind == "point_force":
         extra.append(float(excitation.position))
     x = np.unique(np.concatenate([np.linspace(0.0, L, points), extra]))
-    best, bt, bx = -np.inf, 0.0, 0.0
+    best, bj, bx = -np.inf, 0, 0.0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ImpactBeamWarning)  # said once, below
         for lo in range(0, t.size, 4096):
@@ -218,10 +215,12 @@ def max_bending_stress(result: ResultLike, *, points: int = 201) -> tuple[float,
                 return float("nan"), float("nan"), float("nan")
             i, j = np.unravel_index(np.nanargmax(S), S.shape)
             if S[i, j] > best:
-                best, bt, bx = float(S[i, j]), float(t[lo + j]), float(x[i])
+                best, bj, bx = float(S[i, j]), lo + int(j), float(x[i])
         step_x = L / (points - 1)
+        ta, tb = float(t[max(bj - 1, 0)]), float(t[min(bj + 1, t.size - 1)])  # the best sample's neighbours
+        bt = float(t[bj])
         for _ in range(2):  # alternate: time at the best place, place at the best time
-            bt = _golden(lambda s: _abs_stress(result, bx, s), max(bt - dt, 0.0), min(bt + dt, t_end), 1e-10 * dt)
+            bt = _golden(lambda s: _abs_stress(result, bx, s), ta, tb, 1e-10 * (tb - ta))
             bx = _golden(lambda y: _abs_stress(result, y, bt), max(bx - step_x, 0.0), min(bx + step_x, L), 1e-9 * L)
         best = max(best, _abs_stress(result, bx, bt))
     if sol.packed.space.state(()).modes.n_rigid:

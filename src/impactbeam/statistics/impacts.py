@@ -28,11 +28,14 @@ The contact force is :meth:`~impactbeam.model.beam.Contactor.force`,
 impulses are those of the result's impact table
 (:func:`~impactbeam.result.metrics.contact_forces`). ``F^2`` and
 ``|F v|`` are integrated by Gauss-Legendre quadrature on each side of the
-deepest compression (where ``|F v|`` has its kink), of every segment and, with per-state modes, where the
-force changes sign (:func:`~impactbeam.result.metrics.pushing_parts`), with panels of one
+deepest compression (where ``|F v|`` has its kink), of every event (with per-state modes, of every segment,
+:func:`~impactbeam.result.timegrid.cuts`) and, with per-state modes, where the force changes sign (:func:`~impactbeam.result.metrics.pushing_parts`), with panels of one
 period of the highest retained frequency and 8 nodes each: exact for
 polynomials of degree 15, so within 1e-5 for a sinusoid at that frequency
 (``pi^16 / 16!``) and much closer for the lower modes that carry the force.
+A state that decays faster than that (an over-damped coordinate: a stiff
+dashpot, damping above critical) gets shorter panels where its transients
+start (:func:`~impactbeam.result.timegrid.gauss_panels`).
 """
 
 from __future__ import annotations
@@ -44,11 +47,11 @@ from typing import Any
 import numpy as np
 
 from ..result.metrics import contact_forces, per_state, pushing_parts
-from .window import analysis_window, top_frequency
+from ..result.timegrid import cuts, gauss_panels, gauss_rule, solution_rates
+from .window import analysis_window
 
 __all__ = ["ImpactStatistics", "impact_statistics", "IMPACT_UNITS"]
 
-_NODES = 8
 #: Units of the per-contactor impact statistics.
 IMPACT_UNITS = {
     "n_impacts": "1", "n_complete": "1", "rate": "1/s", "contact_time": "s", "contact_fraction": "1", "force_mean": "N",
@@ -109,22 +112,8 @@ def _intervals(events: list, ci: int, t_end: float) -> list[tuple[float, float, 
     return out
 
 
-def _gauss(a: np.ndarray, b: np.ndarray, panel: float) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes and weights of composite Gauss-Legendre on each [a_i, b_i] (panels of at most ``panel``)."""
-    xg, wg = np.polynomial.legendre.leggauss(_NODES)
-    nodes, weights = [], []
-    for ai, bi in zip(a, b):
-        m = max(int(math.ceil((bi - ai) / panel)), 1)
-        edges = np.linspace(ai, bi, m + 1)
-        half = 0.5 * np.diff(edges)[:, None]
-        nodes.append((0.5 * (edges[:-1] + edges[1:])[:, None] + half * xg[None, :]).ravel())
-        weights.append((half * wg[None, :]).ravel())
-    if not nodes:
-        return np.zeros(0), np.zeros(0)
-    return np.concatenate(nodes), np.concatenate(weights)
-
-
-def _contactor(result: Any, ci: int, lo: float, hi: float, panel: float) -> tuple[dict[str, Any], list[dict]]:
+def _contactor(result: Any, ci: int, lo: float, hi: float, panel: float,
+               decay: float) -> tuple[dict[str, Any], list[dict]]:
     """Summary and per-impact rows of contactor ``ci`` over ``[lo, hi]``."""
     sol = result.solution
     c = result.contactors[ci]
@@ -140,16 +129,15 @@ def _contactor(result: Any, ci: int, lo: float, hi: float, panel: float) -> tupl
         b = np.array([r[1] for r in clipped])
         ext = sol.extrema([(c.position, ai, bi, s, -s * c.gap, ci) for ai, bi in zip(a, b)])
         tp = np.clip(np.nan_to_num(ext[:, 1], nan=0.5 * (a + b)), a, b)
-        # panels end at the deepest compression and at the segments' ends (with per-state modes the state
-        # jumps there, by the projection of eq. 12)
-        starts = np.asarray(sol.segment_starts)
-        cuts = np.unique(np.concatenate([a, tp, b, starts[(starts > a.min()) & (starts < b.max())]]))
+        # panels end at the deepest compression and where a derivative or (per-state modes) the state jumps
+        at = cuts(result, float(a.min()), float(b.max()))
+        edges = np.unique(np.concatenate([a, tp, b, at]))
         if per_state(result):  # and where a projection left the force pulling: its sign changes
-            cuts = np.unique(np.concatenate([cuts] + [np.ravel(pushing_parts(result, ci, ai, bi))
-                                                      for ai, bi in zip(a, b)]))
-        inside = [cuts[(cuts >= ai) & (cuts <= bi)] for ai, bi in zip(a, b)]
-        nodes, weights = _gauss(np.concatenate([e[:-1] for e in inside]), np.concatenate([e[1:] for e in inside]),
-                                panel)
+            edges = np.unique(np.concatenate([edges] + [np.ravel(pushing_parts(result, ci, ai, bi))
+                                                        for ai, bi in zip(a, b)]))
+        inside = [edges[(edges >= ai) & (edges <= bi)] for ai, bi in zip(a, b)]
+        nodes, weights = gauss_rule(*gauss_panels(np.concatenate([e[:-1] for e in inside]),
+                                                  np.concatenate([e[1:] for e in inside]), panel, decay))
         smp = sol.sample(np.array([c.position]), nodes)
         force = c.force(smp.w[:, 0], smp.w_t[:, 0], dash)
         f2 = float(np.sum(weights * force**2))
@@ -207,10 +195,11 @@ def impact_statistics(run: Any, window: tuple[float, float] | None = None) -> Im
     if not hasattr(result, "solution") or not hasattr(result, "contactors"):
         raise TypeError(f"impact_statistics: expected a SteadyState or a SimulationResult, got {type(run).__name__}")
     lo, hi = analysis_window(result, run.window if steady and window is None else window)
-    panel = 2.0 * math.pi / max(top_frequency(result), 1e-300)  # one period of the highest mode
+    omega, decay = solution_rates(result)
+    panel = 2.0 * math.pi / max(omega, 1e-300)  # one period of the highest mode
     per, impacts = [], []
     for ci in range(len(result.contactors)):
-        summary, rows = _contactor(result, ci, lo, hi, panel)
+        summary, rows = _contactor(result, ci, lo, hi, panel, decay)
         if steady:
             summary["impacts_per_forcing_period"] = summary["n_impacts"] / (hi - lo) / float(run.frequency)
         per.append(summary)

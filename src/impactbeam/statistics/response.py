@@ -1,31 +1,35 @@
 """Mean, RMS and standard deviation of the deflection and velocity over the analysis window.
 
-The time averages ``(1/T) int w dt`` and ``(1/T) int w^2 dt`` are the
-trapezoid rule on a uniform grid of ``RMS_SAMPLES_PER_PERIOD = 4`` samples per
-period of the highest retained frequency of the exact solution. ``w^2``
-holds frequencies up to twice the highest one, at most the grid's Nyquist
-frequency, so no product of two modes aliases onto the mean (a term exactly
-at the Nyquist frequency alternates in sign on the grid and averages out);
-what is left is the end correction of the trapezoid rule, of order one
-sample's share, ``1/n``.
+The time averages ``(1/T) int w dt`` and ``(1/T) int w^2 dt`` (and those
+of ``w_t``) are integrated by the composite Gauss-Legendre rule
+(:func:`~impactbeam.result.timegrid.gauss_rule`): the window is cut at every
+event (where a derivative of the response jumps, and with per-state modes
+the state itself, eq. 12; :func:`~impactbeam.result.timegrid.cuts`), and each piece into panels of at most one period
+of the highest retained frequency of the visited states, 8 nodes each. A
+mode's square oscillates twice per such panel, which the rule integrates
+within 1.3e-5; a transient is integrated as well as a steady oscillation (a
+trapezoid rule on 4 samples per period, exact for a stationary record, was
+3e-3 off on short transient runs and 17 % on a fast over-damped one). Where a
+visited state decays faster than a panel resolves, the panels after each cut
+are graded (:func:`~impactbeam.result.timegrid.gauss_panels`).
 """
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .window import analysis_window, scan_times
+from ..result.timegrid import cuts, gauss_panels, gauss_rule, solution_rates
+from .window import analysis_window
 
 if TYPE_CHECKING:
     from ..result.protocol import ResultLike
 
 __all__ = ["response_statistics", "time_average"]
 
-_CHUNK = 65536
-#: Samples per period of the highest retained frequency for the time averages (module docstring).
-RMS_SAMPLES_PER_PERIOD = 4.0
+_CHUNK = 8192  # panels per call of sample: 65,536 nodes
 
 
 def time_average(result: ResultLike, x: np.ndarray, lo: float, hi: float) -> dict[str, np.ndarray]:
@@ -42,16 +46,16 @@ def time_average(result: ResultLike, x: np.ndarray, lo: float, hi: float) -> dic
     dict
         ``mean``, ``mean_square`` [m, m^2], ``velocity_mean``, ``velocity_mean_square``, arrays over ``x``.
     """
-    t = scan_times(result, lo, hi, breaks=False, per_period=RMS_SAMPLES_PER_PERIOD)
-    dt = np.diff(t)
+    omega, decay = solution_rates(result)
+    at = cuts(result, lo, hi)
+    left, right = gauss_panels(at[:-1], at[1:], 2.0 * math.pi / max(omega, 1e-300), decay)
     acc = {k: np.zeros(np.size(x)) for k in ("mean", "mean_square", "velocity_mean", "velocity_mean_square")}
-    for a in range(0, t.size - 1, _CHUNK):
-        b = min(a + _CHUNK, t.size - 1)
-        s = result.solution.sample(np.asarray(x, dtype=float), t[a : b + 1])
-        h = dt[a:b, None]
+    for a in range(0, left.size, _CHUNK):
+        t, wt = gauss_rule(left[a : a + _CHUNK], right[a : a + _CHUNK])
+        s = result.solution.sample(np.asarray(x, dtype=float), t)
         for key, v in (("mean", s.w), ("mean_square", s.w**2), ("velocity_mean", s.w_t),
                        ("velocity_mean_square", s.w_t**2)):
-            acc[key] += np.sum(0.5 * (v[1:] + v[:-1]) * h, axis=0)
+            acc[key] += wt @ v
     span = hi - lo
     return {k: v / span for k, v in acc.items()}
 

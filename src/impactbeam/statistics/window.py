@@ -21,12 +21,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._warnings import emit_user_level_warning
-from ..result.stress import SAMPLES_PER_PERIOD
+from ..result.timegrid import scan_times, top_frequency
 
 if TYPE_CHECKING:
     from ..result.protocol import ResultLike
 
-__all__ = ["analysis_window", "settling_time", "scan_times", "top_frequency", "SETTLE_DECADES"]
+__all__ = ["analysis_window", "settling_time", "scan_times", "top_frequency", "SETTLE_DECADES"]  # the grids: result.timegrid
 
 #: Decades by which the start-up transient's mean square has decayed when the statistics begin.
 SETTLE_DECADES = 3.0
@@ -95,49 +95,3 @@ def analysis_window(result: ResultLike, window: tuple[float, float] | None = Non
         )
         return start, t_end
     return start + settle, t_end
-
-
-def top_frequency(result: ResultLike) -> float:
-    """Highest angular frequency [rad/s] of the visited states' retained modes."""
-    packed = getattr(result.solution, "packed", None)
-    if packed is not None:
-        return float(np.max(packed.om[: packed.nslots]))
-    from ..modal import mode_set
-
-    return float(np.max(mode_set(result.beam, (), result.n_modes).omega))  # type: ignore[attr-defined]
-
-
-def scan_times(result: ResultLike, lo: float, hi: float, *, breaks: bool = True,
-               per_period: float = SAMPLES_PER_PERIOD) -> np.ndarray:
-    """A time grid of ``[lo, hi]`` resolving the exact solution.
-
-    ``per_period`` samples per period of the highest retained frequency
-    (default ``SAMPLES_PER_PERIOD``, as :func:`~impactbeam.result.stress.max_bending_stress`), plus,
-    with ``breaks``, every event and every break of the load's time pieces
-    (where a derivative of the response may jump), sorted and unique.
-
-    Parameters
-    ----------
-    result : SimulationResult
-    lo, hi : float, [s]
-    breaks : bool
-        Add the events and the load's piece boundaries.
-    per_period : float
-        Samples per period of the highest retained frequency.
-
-    Returns
-    -------
-    ndarray, [s]
-    """
-    omega = top_frequency(result)
-    dt = 2.0 * math.pi / max(omega, 1e-300) / per_period
-    n = max(int(math.ceil((hi - lo) / dt)), 1)
-    t = np.linspace(lo, hi, n + 1)
-    if not breaks:
-        return t
-    extra = [np.array([e.time for e in result.events], dtype=float)]
-    pieces = getattr(result.solution, "pieces", None)
-    if pieces is not None:
-        extra.append(np.asarray(pieces[0], dtype=float))
-    cat = np.concatenate([t, *extra])
-    return np.unique(cat[(cat >= lo) & (cat <= hi)])
