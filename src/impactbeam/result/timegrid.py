@@ -159,7 +159,8 @@ def cuts(result: ResultLike, lo: float, hi: float) -> np.ndarray:
 
     A derivative of the response jumps at an event (the contact force starts or, with a dashpot, jumps); with
     per-state modes the state itself jumps by the projection of eq. (12), also at a switch undone at its
-    instant, which records no event: then every segment start is a cut.
+    instant, which records no event: then every segment start that is not a break of the load is a cut too
+    (a load's break moves no state; a random record has thousands).
 
     Parameters
     ----------
@@ -171,10 +172,11 @@ def cuts(result: ResultLike, lo: float, hi: float) -> np.ndarray:
     ndarray, [s]
         Sorted and unique, ``lo`` first and ``hi`` last.
     """
+    at = np.array([e.time for e in result.events], dtype=float)
     if per_state(result):
-        at = np.asarray(result.solution.segment_starts, dtype=float)
-    else:
-        at = np.array([e.time for e in result.events], dtype=float)
+        starts = np.asarray(result.solution.segment_starts, dtype=float)
+        pieces = getattr(result.solution, "pieces", None)
+        at = np.concatenate([at, starts if pieces is None else np.setdiff1d(starts, pieces[0])])
     return np.unique(np.concatenate([[lo, hi], at[(at > lo) & (at < hi)]]))
 
 
