@@ -304,12 +304,18 @@ def test_a_dashpot_releases_before_the_penetration_returns():
 
 
 def test_dashpots_report_what_they_dissipate():
-    # the ledger: kinetic + strain + contactor energy + beam damping + dashpots = input work,
-    # sampled at 2e-6 s (trapezoid rule: ~3e-4 of the input work, the sampling's own error)
+    # the ledger: kinetic + strain + contactor energy + beam damping + dashpots = input work. The works are
+    # integrated on the exact solution (Gauss panels between output times, events and load breaks), so the
+    # ledger closes to round-off (1e-9 of the input work: the switches' energy changes are round-off with the
+    # default basis) and is the same at any output step (1e-9: the panels differ, Gauss's error ~1e-12).
+    # On the output grid's trapezoid rule it closed to 3e-4 at 2e-6 s and to 2 % at 1e-3 s on Case 3.
     res = run(with_options(_dash(0.5), time_step=2e-6))
     en = res.energy
     assert en["dashpots"][-1] > 0.05 * en["input_work"][-1]
-    assert np.abs(en["residual"]).max() <= 5e-4 * en["input_work"][-1]
+    assert np.abs(en["residual"]).max() <= 1e-9 * en["input_work"][-1]
+    coarse = run(with_options(_dash(0.5), time_step=1e-4)).energy
+    for key in ("input_work", "dissipated", "dashpots"):
+        assert coarse[key][-1] == pytest.approx(en[key][-1], rel=1e-9), key
     undamped = run(with_options(problem(damping=Damping(0.011, 0.02)), time_step=2e-6))
     assert np.all(undamped.energy["dashpots"] == 0.0)
 

@@ -13,6 +13,7 @@ import numpy as np
 from .._memory import check_output_size, sample_count
 from ..model.beam import Beam, Contactor
 from ..exceptions import ParameterError
+from .timegrid import cumulative_power
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -71,9 +72,9 @@ class SimulationResult:
         Every impact and rebound at its exact time.
     energy : dict of ndarray (n_t,), [J]
         ``kinetic``, ``strain`` (beam and end supports), ``contactor``,
-        ``input_work`` and ``dissipated`` (cumulative, trapezoid rule on the
-        samples), ``total`` and ``residual``
-        (``total(0) + input_work - dissipated - total``).
+        ``input_work``, ``dissipated`` and ``dashpots`` (cumulative, integrated
+        on the exact solution: the same at any output step), ``total`` and
+        ``residual`` (``total(0) + input_work - dissipated - dashpots - total``).
     eta, eta_t : ndarray, (n_t, n_state_modes)
         Modal coordinates in the basis of the state at each sample (``n_modes``
         modes, plus one attachment shape per contactor position with the
@@ -311,7 +312,7 @@ class SimulationResult:
     @functools.cached_property
     def energy(self) -> dict[str, np.ndarray]:
         en = self._modal_grid["energies"]
-        kinetic, modal_strain, load_power, damping_power, dashpot_power = en.T
+        kinetic, modal_strain = en[:, 0], en[:, 1]
         contactor_energy = np.zeros(self.time.size)
         spring_at_zero_gap = np.zeros(self.time.size)
         for i, c in enumerate(self.contactors):
@@ -322,17 +323,11 @@ class SimulationResult:
             spring_at_zero_gap += np.where(on, 0.5 * c.stiffness * wc**2, 0.0)
         strain = modal_strain - spring_at_zero_gap
         total = kinetic + strain + contactor_energy
-        dt = np.diff(self.time)
-
-        def cumulative(p: np.ndarray) -> np.ndarray:
-            return np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * dt)])
-
-        input_work = cumulative(load_power)
-        dissipated = cumulative(damping_power)
+        input_work, dissipated, dashpot_work = cumulative_power(self, self.time).T  # exact, not the output grid's
         t_rel, lost = self.solution.release_losses()
         at_release = np.cumsum(np.bincount(np.searchsorted(self.time, t_rel, side="left"), weights=lost,
                                            minlength=self.time.size + 1)[: self.time.size])
-        dashpots = cumulative(dashpot_power) + at_release
+        dashpots = dashpot_work + at_release
         return {
             "kinetic": kinetic, "strain": strain, "contactor": contactor_energy, "input_work": input_work,
             "dissipated": dissipated, "dashpots": dashpots, "total": total,

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
 
 __all__ = ["solution_rates", "top_frequency", "scan_times", "graded_offsets", "gauss_panels", "gauss_rule", "cuts",
-           "SAMPLES_PER_PERIOD", "GAUSS_NODES"]
+           "cumulative_power", "SAMPLES_PER_PERIOD", "GAUSS_NODES"]
 
 #: Samples per period of the highest retained frequency in the scans of the stress and of its turning points.
 SAMPLES_PER_PERIOD = 8
@@ -200,20 +200,28 @@ def gauss_panels(a: np.ndarray, b: np.ndarray, panel: float, decay: float = 0.0)
     Returns
     -------
     (ndarray, ndarray)
-        Left and right ends of the panels, interval by interval.
+        Left and right ends of the panels, in the order of their left ends.
     """
     lead = (2.0 ** np.arange(int(math.ceil(math.log2(decay * panel))) + 1) - 1.0) / decay \
         if decay * panel > 1.0 else np.zeros(1)  # the graded panels' edges, the last panel / 2 or more long
-    lefts, rights = [], []
-    for ai, bi in zip(np.asarray(a, dtype=float), np.asarray(b, dtype=float)):
-        graded = ai + lead[ai + lead < bi]
-        m = max(int(math.ceil((bi - graded[-1]) / panel)), 1)
-        edges = np.concatenate([graded[:-1], np.linspace(graded[-1], bi, m + 1)])
-        lefts.append(edges[:-1])
-        rights.append(edges[1:])
-    if not lefts:
-        return np.zeros(0), np.zeros(0)
-    return np.concatenate(lefts), np.concatenate(rights)
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    g = np.searchsorted(lead, b - a, side="left")  # graded edges inside each interval (lead[0] = 0: one at least)
+    g = np.where(a + lead[np.maximum(g - 1, 0)] < b, g, g - 1).clip(1)  # never a panel of zero length
+    start = a + lead[g - 1]  # where the equal panels begin
+    m = np.maximum(np.ceil((b - start) / panel), 1.0).astype(np.int64)
+    # the graded panels [a + lead[k], a + lead[k + 1]], k < g - 1, then m equal panels on [start, b]
+    gi = np.repeat(np.arange(a.size), g - 1)
+    gk = np.arange(gi.size) - np.repeat(np.cumsum(g - 1) - (g - 1), g - 1)
+    ui = np.repeat(np.arange(a.size), m)
+    uk = (np.arange(ui.size) - np.repeat(np.cumsum(m) - m, m)).astype(float)
+    span = (b - start)[ui]
+    u_left = start[ui] + span * (uk / m[ui])
+    u_right = np.where(uk + 1.0 == m[ui], b[ui], start[ui] + span * ((uk + 1.0) / m[ui]))
+    left = np.concatenate([a[gi] + lead[gk], u_left])
+    right = np.concatenate([a[gi] + lead[gk + 1], u_right])
+    order = np.argsort(left, kind="stable")
+    return left[order], right[order]
 
 
 def gauss_rule(left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -235,3 +243,45 @@ def gauss_rule(left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndar
     half = 0.5 * (np.asarray(right) - np.asarray(left))[:, None]
     mid = 0.5 * (np.asarray(right) + np.asarray(left))[:, None]
     return (mid + half * xg[None, :]).ravel(), (half * wg[None, :]).ravel()
+
+
+def cumulative_power(result: ResultLike, times: np.ndarray) -> np.ndarray:
+    """The work of the load, the beam's damping and the dashpots from ``times[0]`` to each of ``times``.
+
+    The powers of :meth:`~impactbeam.solver.solution.Solution.sample` (``energy=True``) are integrated on
+    the exact solution, not on the output grid: Gauss panels (:func:`gauss_panels`) end at every output time,
+    every cut (:func:`cuts`) and every break of the load (where the load's power jumps), so the ledger of
+    ``result.energy`` is the same whatever the output step.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    times : ndarray, [s]
+        Increasing.
+
+    Returns
+    -------
+    ndarray, (n_t, 3), [J]
+        Input work, dissipated energy and dashpot work (NaN after a run that stopped early).
+    """
+    t = np.asarray(times, dtype=float)
+    out = np.zeros((t.size, 3))
+    if t.size < 2:
+        return out
+    lo, hi = float(t[0]), float(t[-1])
+    omega, decay = solution_rates(result)
+    breaks = [cuts(result, lo, hi), t]
+    pieces = getattr(result.solution, "pieces", None)
+    if pieces is not None:
+        p = np.asarray(pieces[0], dtype=float)
+        breaks.append(p[(p > lo) & (p < hi)])
+    at = np.unique(np.concatenate(breaks))
+    left, right = gauss_panels(at[:-1], at[1:], 2.0 * math.pi / max(omega, 1e-300), decay)
+    after = np.searchsorted(t, left, side="right")  # each panel adds to the output times after its start
+    origin = np.zeros(1)
+    for a in range(0, left.size, 8192):
+        nodes, weights = gauss_rule(left[a : a + 8192], right[a : a + 8192])
+        power = result.solution.sample(origin, nodes, energy=True).energies[:, 2:5]
+        per_panel = (weights[:, None] * power).reshape(-1, GAUSS_NODES, 3).sum(axis=1)
+        np.add.at(out, after[a : a + 8192], per_panel)
+    return np.cumsum(out, axis=0)
