@@ -28,8 +28,10 @@ The contact force is :meth:`~impactbeam.model.beam.Contactor.force`,
 impulses are those of the result's impact table
 (:func:`~impactbeam.result.metrics.contact_forces`). ``F^2`` and
 ``|F v|`` are integrated by Gauss-Legendre quadrature on each side of the
-deepest compression (where ``|F v|`` has its kink), of every event (with per-state modes, of every segment,
-:func:`~impactbeam.result.timegrid.cuts`) and, with per-state modes, where the force changes sign (:func:`~impactbeam.result.metrics.pushing_parts`), with panels of one
+deepest compression (where ``|F v|`` has its kink), of every event (with
+per-state modes, of every segment: :func:`~impactbeam.result.timegrid.cuts`)
+and, with per-state modes, where the force changes sign
+(:func:`~impactbeam.result.metrics.pushing_parts`), with panels of one
 period of the highest retained frequency and 8 nodes each: exact for
 polynomials of degree 15, so within 1e-5 for a sinusoid at that frequency
 (``pi^16 / 16!``) and much closer for the lower modes that carry the force.

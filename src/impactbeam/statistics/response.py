@@ -4,8 +4,9 @@ The time averages ``(1/T) int w dt`` and ``(1/T) int w^2 dt`` (and those
 of ``w_t``) are integrated by the composite Gauss-Legendre rule
 (:func:`~impactbeam.result.timegrid.gauss_rule`): the window is cut at every
 event (where a derivative of the response jumps, and with per-state modes
-the state itself, eq. 12; :func:`~impactbeam.result.timegrid.cuts`), and each piece into panels of at most one period
-of the highest retained frequency of the visited states, 8 nodes each. A
+the state itself, eq. 12; :func:`~impactbeam.result.timegrid.cuts`), and
+each piece into panels of at most one period of the highest retained
+frequency of the visited states, 8 nodes each. A
 mode's square oscillates twice per such panel, which the rule integrates
 within 1.3e-5; a transient is integrated as well as a steady oscillation (a
 trapezoid rule on 4 samples per period, exact for a stationary record, was

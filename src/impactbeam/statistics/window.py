@@ -26,7 +26,8 @@ from ..result.timegrid import scan_times, top_frequency
 if TYPE_CHECKING:
     from ..result.protocol import ResultLike
 
-__all__ = ["analysis_window", "settling_time", "scan_times", "top_frequency", "SETTLE_DECADES"]  # the grids: result.timegrid
+# scan_times and top_frequency: from result.timegrid (their one copy), kept here for the statistics
+__all__ = ["analysis_window", "settling_time", "scan_times", "top_frequency", "SETTLE_DECADES"]
 
 #: Decades by which the start-up transient's mean square has decayed when the statistics begin.
 SETTLE_DECADES = 3.0
