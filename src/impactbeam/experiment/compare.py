@@ -380,9 +380,12 @@ def compare(
     -----
     The simulation runs to the last measured time and is evaluated exactly
     at the measured times. The quantities (:func:`response_features`) are
-    computed the same way on both: on the measured samples and on the
-    simulation's output grid (``solver.time_step``).
+    computed the same way on both: on the measured samples and on the exact
+    solution scanned at 8 samples per period of its highest frequency
+    (:func:`~impactbeam.result.timegrid.scan_times`), not on the output grid:
+    they do not depend on ``solver.time_step``.
     """
+    from ..result.timegrid import scan_times
     from ..simulation import simulate
 
     sc, meas = prepare_run(scenario, measured, excitation, hold, window)
@@ -395,7 +398,7 @@ def compare(
     sign = response_point(sc.contactors, sc.output_points)[1]
     gap = sc.contactors[0].gap if sc.contactors else None
     fm = response_features(meas.time, sign * meas.values, gap=gap)
-    tg = result.time
+    tg = scan_times(result, 0.0, float(result.solution.t_end), breaks=False)
     fs = response_features(tg, sign * result.displacement([x], tg)[0], gap=gap)
     feats: dict[str, dict[str, float | None]] = {}
     for k in FEATURES:
