@@ -135,7 +135,13 @@ def test_no_contactor_orientation():
     sc = paper.case(12).with_values({"output.point_ratios": [0.4840, 1.0]})
     res = ib.simulate(sc)
     pm = paper.paper_metrics(res)
-    assert pm.max_response == pytest.approx(-res.w[:, 0].min(), rel=1e-12)
+    # the exact maximum (the solver's extremum), not the output grid's: the sampled one lies within
+    # (omega dt)^2 / 2 below it (rel 1e-5 at 57 Hz and 10 us), and the same at any output step
+    assert pm.max_response >= -res.w[:, 0].min()
+    assert pm.max_response == pytest.approx(-res.w[:, 0].min(), rel=1e-5)
+    coarse = paper.paper_metrics(ib.simulate(sc.with_values({"solver.time_step": 1e-3})))
+    for key in ("max_response", "t_max", "min_response", "negative_lobe_duration", "min_response_rest"):
+        assert getattr(coarse, key) == pytest.approx(getattr(pm, key), rel=1e-12), key
     assert pm.min_response < 0
     # the negative lobe of a free vibration lasts about half a period of the first mode (57 Hz):
     # the pulse ends at 15 ms, inside the lobe, so allow 10 % around T/2 = 8.8 ms

@@ -8,10 +8,14 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
+
 import numpy as np
+
+from ..result.timegrid import scan_times
+from .data import SPECIMEN
+
 if TYPE_CHECKING:
     from ..result import SimulationResult
-from .data import SPECIMEN
 
 __all__ = ["PaperMetrics", "paper_metrics"]
 
@@ -133,9 +137,10 @@ def paper_metrics(result: SimulationResult, *, free_period: float | None = None)
             fraction = in_first / cycle
         else:
             fraction = nan
-        if iv and math.isfinite(iv[0][1]):
-            after = t > iv[0][1]
-            rebound = float(d[after].max()) if after.any() else nan
+        if iv and math.isfinite(iv[0][1]) and iv[0][1] < t_end:  # the largest d after the first contact, exact
+            ext = result.solution.extrema([(c.position, float(iv[0][1]), t_end, -c.direction, -c.direction * gap,
+                                            None)])
+            rebound = float(ext[0, 0])
         else:
             rebound = nan
         dt = float(t[1] - t[0]) if t.size > 1 else 0.0
@@ -159,30 +164,36 @@ def paper_metrics(result: SimulationResult, *, free_period: float | None = None)
             max_response_rest=_num(m["max_response"]),
             min_response_rest=_num(m["min_response"]),
         )
-    # no contactor: d = -w at the output point nearest 0.4840 L
+    # no contactor: d = -w at the output point nearest 0.4840 L, on the exact solution (not the output grid)
     a = SPECIMEN["contact_position_ratio"] * result.beam.length
-    j = int(np.argmin(np.abs(np.asarray(result.points) - a)))
-    d = -np.asarray(result.w[:, j])
-    k = int(np.argmax(d))
-    neg = np.nonzero(d[k:] < 0.0)[0]
+    x = float(np.asarray(result.points)[int(np.argmin(np.abs(np.asarray(result.points) - a)))])
+    sol = result.solution
+    top, t_top = (float(v) for v in sol.extrema([(x, 0.0, t_end, -1.0, 0.0, None)])[0])
+    lowest = -float(sol.extrema([(x, 0.0, t_end, 1.0, 0.0, None)])[0, 0])
+    lobe_min, lobe = nan, nan
+    tg = scan_times(result, t_top, t_end, breaks=False)  # locates the lobe's crossings; brentq refines them
+    d = -result.displacement([x], tg)[0]
+    neg = np.nonzero(d < 0.0)[0]
     if neg.size:
-        i0 = k + int(neg[0])
+        i0 = int(neg[0])
         back = np.nonzero(d[i0:] >= 0.0)[0]
-        i1 = i0 + int(back[0]) if back.size else d.size - 1
-        lobe_min = float(d[i0:i1 + 1].min())
-        lobe = _crossing(t, d, i1) - _crossing(t, d, i0) if back.size else nan
-    else:
-        lobe_min, lobe = nan, nan
+        down = _crossing(result, x, tg, d, i0)
+        up = _crossing(result, x, tg, d, i0 + int(back[0])) if back.size else t_end
+        lobe_min = -float(sol.extrema([(x, down, up, 1.0, 0.0, None)])[0, 0])
+        lobe = up - down if back.size else nan
     return PaperMetrics(
-        max_response=float(d[k]), t_max=float(t[k]), free_duration=nan, min_response=lobe_min,
+        max_response=top, t_max=t_top, free_duration=nan, min_response=lobe_min,
         contact_duration=nan, first_impact_time=nan, n_impacts=0, total_contact_time=0.0, cycle_time=nan,
         impacts_per_cycle=0, contact_fraction=nan, rebound_response=nan, negative_lobe_duration=float(lobe),
-        gap=0.0, max_response_rest=float(d[k]), min_response_rest=float(d.min()),
+        gap=0.0, max_response_rest=top, min_response_rest=lowest,
     )
 
 
-def _crossing(t: np.ndarray, y: np.ndarray, i: int) -> float:
-    """Zero crossing between samples i-1 and i, by linear interpolation."""
-    if i == 0 or y[i] == y[i - 1]:
+def _crossing(result: SimulationResult, x: float, t: np.ndarray, d: np.ndarray, i: int) -> float:
+    """The zero of ``d = -w(x)`` between samples ``i - 1`` and ``i`` of ``t``, on the exact solution."""
+    from scipy.optimize import brentq
+
+    if i == 0 or d[i] == 0.0:
         return float(t[i])
-    return float(t[i - 1] + (t[i] - t[i - 1]) * y[i - 1] / (y[i - 1] - y[i]))
+    return float(brentq(lambda s: float(result.displacement([x], [s])[0, 0]), float(t[i - 1]), float(t[i]),
+                        xtol=1e-15))
