@@ -82,15 +82,27 @@ class _Runner:
 
 
 def _free_decay(result: SimulationResult) -> dict[str, float]:
-    """First-mode frequency (zero crossings) and damping (log decrement) from a release record at the tip."""
-    t = np.asarray(result.time)
-    w = np.asarray(result.w[:, -1])
-    sel = t >= 0.05  # let modes >= 2 die out (their decay time 1/(xi w) < 45 ms)
-    t, w = t[sel], w[sel]
+    """First-mode frequency (zero crossings) and damping (log decrement) from a release record at the tip.
+
+    On the exact solution, not the output grid: the up-crossings of ``w`` are located on its scan grid
+    (:func:`~impactbeam.result.timegrid.scan_times`) and refined by Brent's method, the peaks between them
+    are the solver's extrema.
+    """
+    from scipy.optimize import brentq
+
+    from ..result.timegrid import scan_times
+
+    x, t_end = float(result.points[-1]), float(result.solution.t_end)
+    if not t_end > 0.05:
+        return {"frequency_hz": float("nan"), "damping_ratio": float("nan"), "cycles": 0.0}
+    t = scan_times(result, 0.05, t_end, breaks=False)  # from 50 ms: modes >= 2 have died out (1/(xi w) < 45 ms)
+    w = result.displacement([x], t)[0]
     up = np.nonzero((w[:-1] < 0) & (w[1:] >= 0))[0]
-    tc = t[up] - w[up] * (t[up + 1] - t[up]) / (w[up + 1] - w[up])
+    tc = np.array([brentq(lambda s: float(result.displacement([x], [s])[0, 0]), float(t[i]), float(t[i + 1]),
+                          xtol=1e-15) if w[i + 1] > 0 else float(t[i + 1]) for i in up])
     f = (tc.size - 1) / (tc[-1] - tc[0]) if tc.size > 2 else float("nan")
-    peaks = [float(np.max(w[a:b])) for a, b in zip(up[:-1], up[1:])]
+    peaks = [float(v) for v in result.solution.extrema([(x, a, b, 1.0, 0.0, None)
+                                                         for a, b in zip(tc[:-1], tc[1:])])[:, 0]]
     if len(peaks) > 2 and peaks[-1] > 0:
         delta = math.log(peaks[0] / peaks[-1]) / (len(peaks) - 1)
         xi = ratio_from_decrement(delta)
