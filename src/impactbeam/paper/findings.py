@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 import numpy as np
+
+from ..result.timegrid import scan_times
 from .conventions import PaperMetrics
 from .data import PAPER_CONVERGENCE
 from .plan import FLEX_HEIGHTS, FLEX_STIFFNESS, PARAMETER_STUDY, _BASE_VALUE, _quasi_static_deflection
@@ -390,12 +392,11 @@ def _parameter_findings(data: dict[str, Any]) -> list[Finding]:
     a = sc.contactors[0].position
     q = sc.beam.mass_per_length * sc.excitation.amplitude
     u_static = _quasi_static_deflection(sc.beam, a, q)  # away from the contactor
-    t = np.asarray(res.time)
-    inside = (t >= 0.25 * t1) & (t <= 0.75 * t1)
-    u = -np.asarray(res.w_contact[:, 0])
-    u_qs = u_static * np.sin(np.pi * t / t1)
-    mean_offset = float(np.mean((u - u_qs)[inside]))
-    amp_osc = float(np.max(np.abs(u - u_qs)[inside]))
+    lo, hi = 0.25 * t1, 0.75 * t1  # the middle half of the pulse, on the exact solution (not the output grid)
+    tq = scan_times(res, lo, hi, breaks=False)
+    amp_osc = float(np.max(np.abs(-res.displacement([a], tq)[0] - u_static * np.sin(np.pi * tq / t1))))
+    quasi_static = u_static * t1 / np.pi * (math.cos(np.pi * lo / t1) - math.cos(np.pi * hi / t1))
+    mean_offset = (-res.solution.integral(a, lo, hi) - quasi_static) / (hi - lo)
     free_during = not any(ev.time < t1 for ev in res.events if ev.kind == "impact")
     ok = free_during and abs(mean_offset) < 0.2 * u_static
     out.append(Finding("duration", "With a long enough pulse the beam vibrates about a balanced (quasi-static) "
