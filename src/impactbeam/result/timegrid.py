@@ -1,4 +1,8 @@
-"""Time grids that resolve the exact solution: the scans of the stress, the fatigue and the time averages.
+"""Time grids and quadrature rules that resolve the exact solution, not the output grid.
+
+The scans of the stress and its turning points (:func:`scan_times`), the
+time averages of the statistics and the energy ledger (:func:`gauss_panels`,
+:func:`gauss_rule`, :func:`cumulative_power`) all take their rule from here.
 
 Between events the response is a sum of the visited states' coordinates
 (paper eq. 10): oscillations ``e^{-a t} cos(w t)`` of frequencies up to
@@ -8,20 +12,20 @@ critical, a stiff dashpot, Rayleigh damping of the high modes), exponentials
 ``omega_max``. A grid of ``per_period`` samples per period of
 ``omega_max`` resolves the oscillations; a fast exponential started at an
 event or a break of the load dies within a few of its time constants
-``1/D``, between two samples of that grid, where the trapezoid rule and
-a scan for turning points would miss it. (Found on a stiff stop with a
+``1/D``, between two samples of that grid, where a quadrature and a scan
+for turning points would miss it. (Found on a stiff stop with a
 coefficient of restitution engaged at t = 0: the tip's velocity falls by a
 factor of ten within one step of the uniform grid, and the RMS velocity was
 11 % off.)
 
 So when the fastest decay rate ``D`` of the visited states exceeds
 :data:`GRADED_ABOVE` samples' worth of the uniform step ``h`` (``D h >
-0.1``), the grid also holds, after every event and every break of the load,
+0.1``), a scan also holds, after every event and every break of the load,
 the offsets ``GRADE_FIRST / D * GRADE_RATIO^k``, until their spacing
 reaches ``h`` (at ``11 h``: slower coordinates that ``h`` still resolves
-poorly have decayed by then). The trapezoid rule on that grid integrates ``e^{-2 D t}`` within
-about 1.5e-3 of the transient's own integral (its local steps are 0.09 of
-the distance to the break).
+poorly have decayed by then); its local steps are 0.09 of the distance to
+the break. The Gauss panels are graded likewise, ``1/D, 2/D, 4/D, ...``
+after each cut (:func:`gauss_panels`).
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
 
 __all__ = ["solution_rates", "top_frequency", "scan_times", "graded_offsets", "gauss_panels", "gauss_rule", "cuts",
-           "cumulative_power", "SAMPLES_PER_PERIOD", "GAUSS_NODES"]
+           "cumulative_power", "SAMPLES_PER_PERIOD", "GAUSS_NODES", "PANELS_PER_CALL"]
 
 #: Samples per period of the highest retained frequency in the scans of the stress and of its turning points.
 SAMPLES_PER_PERIOD = 8
@@ -47,6 +51,8 @@ GRADED_ABOVE = 0.1
 GRADE_FIRST, GRADE_RATIO = 0.02, 1.1
 #: Nodes of each Gauss-Legendre panel (:func:`gauss_rule`).
 GAUSS_NODES = 8
+#: Panels per call of ``sample`` in the quadratures (65,536 nodes: ~10 MB of work arrays).
+PANELS_PER_CALL = 8192
 
 
 def solution_rates(result: ResultLike) -> tuple[float, float]:
@@ -114,9 +120,9 @@ def scan_times(result: ResultLike, lo: float, hi: float, *, breaks: bool = True,
     (default ``SAMPLES_PER_PERIOD``), plus, with ``breaks``, every event and
     every break of the load's time pieces (where a derivative of the
     response may jump; with per-state modes, whose switches move the state,
-    the instant before each event too), and, when a visited state decays faster than that
-    grid resolves, the graded offsets after each of them (with or without
-    ``breaks``), sorted and unique.
+    the instant before each event too), and, when a visited state decays
+    faster than that grid resolves, those instants and the graded offsets
+    after each of them (with or without ``breaks``), sorted and unique.
 
     Parameters
     ----------
@@ -279,9 +285,9 @@ def cumulative_power(result: ResultLike, times: np.ndarray) -> np.ndarray:
     left, right = gauss_panels(at[:-1], at[1:], 2.0 * math.pi / max(omega, 1e-300), decay)
     after = np.searchsorted(t, left, side="right")  # each panel adds to the output times after its start
     origin = np.zeros(1)
-    for a in range(0, left.size, 8192):
-        nodes, weights = gauss_rule(left[a : a + 8192], right[a : a + 8192])
+    for a in range(0, left.size, PANELS_PER_CALL):
+        nodes, weights = gauss_rule(left[a : a + PANELS_PER_CALL], right[a : a + PANELS_PER_CALL])
         power = result.solution.sample(origin, nodes, energy=True).energies[:, 2:5]
         per_panel = (weights[:, None] * power).reshape(-1, GAUSS_NODES, 3).sum(axis=1)
-        np.add.at(out, after[a : a + 8192], per_panel)
+        np.add.at(out, after[a : a + PANELS_PER_CALL], per_panel)
     return np.cumsum(out, axis=0)

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..result.timegrid import cuts, gauss_panels, gauss_rule, solution_rates
+from ..result.timegrid import PANELS_PER_CALL, cuts, gauss_panels, gauss_rule, solution_rates
 from .window import analysis_window
 
 if TYPE_CHECKING:
@@ -30,7 +30,6 @@ if TYPE_CHECKING:
 
 __all__ = ["response_statistics", "time_average"]
 
-_CHUNK = 8192  # panels per call of sample: 65,536 nodes
 
 
 def time_average(result: ResultLike, x: np.ndarray, lo: float, hi: float) -> dict[str, np.ndarray]:
@@ -51,8 +50,8 @@ def time_average(result: ResultLike, x: np.ndarray, lo: float, hi: float) -> dic
     at = cuts(result, lo, hi)
     left, right = gauss_panels(at[:-1], at[1:], 2.0 * math.pi / max(omega, 1e-300), decay)
     acc = {k: np.zeros(np.size(x)) for k in ("mean", "mean_square", "velocity_mean", "velocity_mean_square")}
-    for a in range(0, left.size, _CHUNK):
-        t, wt = gauss_rule(left[a : a + _CHUNK], right[a : a + _CHUNK])
+    for a in range(0, left.size, PANELS_PER_CALL):
+        t, wt = gauss_rule(left[a : a + PANELS_PER_CALL], right[a : a + PANELS_PER_CALL])
         s = result.solution.sample(np.asarray(x, dtype=float), t)
         for key, v in (("mean", s.w), ("mean_square", s.w**2), ("velocity_mean", s.w_t),
                        ("velocity_mean_square", s.w_t**2)):
