@@ -34,11 +34,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .timegrid import cuts, per_state
+
 if TYPE_CHECKING:
     from .protocol import ResultLike
     from ..model.beam import Contactor
 
-__all__ = ["compute_metrics", "contact_forces", "contact_intervals", "response_point", "per_state", "pushing_parts",
+__all__ = ["compute_metrics", "contact_forces", "contact_intervals", "response_point", "pushing_parts",
            "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
@@ -181,26 +183,10 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     return out
 
 
-def per_state(result: ResultLike) -> bool:
-    """Whether the run's states have their own modes (the paper's basis, or a beam free to move as a rigid
-    body), whose switches move the state by the projection of eq. (12).
-
-    Parameters
-    ----------
-    result : SimulationResult
-        Of the exact engine or of the ``solve_ivp`` path.
-    """
-    from ..solver.ritz_space import RitzStateSpace
-
-    sol = result.solution  # the exact solution's packed problem, or the solve_ivp path's integrator
-    space = getattr(getattr(sol, "packed", None), "space", None) or getattr(getattr(sol, "ref", None), "space", None)
-    return space is not None and not isinstance(space, RitzStateSpace)
-
-
 def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple[float, float]]:
     """The parts of the contact ``[a, b]`` of contactor ``ci`` where its force ``k d + c_d d'`` pushes.
 
-    Split at the segments' ends (with per-state modes the state jumps there) and at the force's sign
+    Split where the state jumps (:func:`~impactbeam.result.timegrid.cuts`) and at the force's sign
     changes, located on 513 points of the contact, then by Brent's method; a part keeps its own ends.
 
     Parameters
@@ -229,13 +215,13 @@ def pushing_parts(result: ResultLike, ci: int, a: float, b: float) -> list[tuple
         smp = sol.sample(np.array([c.position]), np.atleast_1d(np.asarray(t, dtype=float)))
         return c.direction * (smp.w[:, 0] + r * smp.w_t[:, 0]) - c.gap
 
-    edges = np.array([a] + [float(t) for t in sol.segment_starts if a < t < b] + [b])
+    edges = cuts(result, a, b)  # where the state jumps
     t = np.linspace(a, float(np.nextafter(b, -np.inf)), 513)  # (a sample at b is of the next segment)
     v = g(t)
     roots = []
     for j in np.flatnonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0.0):
         if np.any((edges > t[j]) & (edges <= t[j + 1])):
-            continue  # a jump at a segment's end is not a root
+            continue  # a jump of the state is not a root
         try:
             roots.append(brentq(lambda x: float(g(x)[0]), t[j], t[j + 1], xtol=1e-15 * max(abs(b), 1e-300)))
         except ValueError:  # the ends' signs differ only in the last bits of a vectorised sample: no root
@@ -251,8 +237,9 @@ def _clip_pulling(result: ResultLike, rc: np.ndarray, ra: np.ndarray, rbe: np.nd
 
     The contact force never pulls (:meth:`~impactbeam.model.beam.Contactor.force`). With the shared basis an
     engaged contactor's force stays positive until its release and the state is continuous, so the table's
-    closed form ``k int d dt + c_d [d]`` is its integral. With per-state modes (:func:`per_state`) every
-    switch moves the state, and can leave a struck contactor on the wrong side: the impulse is summed over
+    closed form ``k int d dt + c_d [d]`` is its integral. With per-state modes
+    (:func:`~impactbeam.result.timegrid.per_state`) every switch moves the state, and can leave a struck
+    contactor on the wrong side: the impulse is summed over
     the parts where the force pushes (:func:`pushing_parts`), the dashpot's share ``c_d [d]`` within each
     (from the left of its end); a contact that never pushes gets 0. Contact ``i``: contactor ``rc[i]`` on
     ``[ra[i], rbe[i]]``, its peak force ``force[i]``; ``impulse`` is changed in place.

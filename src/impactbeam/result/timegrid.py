@@ -35,12 +35,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .metrics import per_state
-
 if TYPE_CHECKING:
     from .protocol import ResultLike
 
-__all__ = ["solution_rates", "top_frequency", "scan_times", "graded_offsets", "gauss_panels", "gauss_rule", "cuts",
+__all__ = ["per_state", "solution_rates", "top_frequency", "scan_times", "graded_offsets", "gauss_panels", "gauss_rule",
+           "cuts",
            "cumulative_power", "SAMPLES_PER_PERIOD", "GAUSS_NODES", "PANELS_PER_CALL"]
 
 #: Samples per period of the highest retained frequency in the scans of the stress and of its turning points.
@@ -160,6 +159,36 @@ def scan_times(result: ResultLike, lo: float, hi: float, *, breaks: bool = True,
     return np.unique(cat[(cat >= lo) & (cat <= hi)])
 
 
+def per_state(result: ResultLike) -> bool:
+    """Whether the run's states have their own modes (the paper's basis, or a beam free to move as a rigid
+    body), whose switches move the state by the projection of eq. (12).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        Of the exact engine or of the ``solve_ivp`` path.
+    """
+    from ..solver.ritz_space import RitzStateSpace
+
+    sol = result.solution  # the exact solution's packed problem, or the solve_ivp path's integrator
+    space = getattr(getattr(sol, "packed", None), "space", None) or getattr(getattr(sol, "ref", None), "space", None)
+    return space is not None and not isinstance(space, RitzStateSpace)
+
+
+def _jump_times(result: ResultLike) -> np.ndarray:
+    """The events and, with per-state modes, the segment starts that are not breaks of the load; sorted, kept
+    with the solution (a random record has ~10^6 segments, and every contact of it asks)."""
+    memo = result.solution.__dict__
+    if "_jump_times" not in memo:
+        at = np.array([e.time for e in result.events], dtype=float)
+        if per_state(result):
+            starts = np.asarray(result.solution.segment_starts, dtype=float)
+            pieces = getattr(result.solution, "pieces", None)
+            at = np.concatenate([at, starts if pieces is None else np.setdiff1d(starts, pieces[0])])
+        memo["_jump_times"] = np.unique(at)
+    return memo["_jump_times"]
+
+
 def cuts(result: ResultLike, lo: float, hi: float) -> np.ndarray:
     """Where an integration rule's panels must end in ``[lo, hi]``: the ends and every event.
 
@@ -178,12 +207,9 @@ def cuts(result: ResultLike, lo: float, hi: float) -> np.ndarray:
     ndarray, [s]
         Sorted and unique, ``lo`` first and ``hi`` last.
     """
-    at = np.array([e.time for e in result.events], dtype=float)
-    if per_state(result):
-        starts = np.asarray(result.solution.segment_starts, dtype=float)
-        pieces = getattr(result.solution, "pieces", None)
-        at = np.concatenate([at, starts if pieces is None else np.setdiff1d(starts, pieces[0])])
-    return np.unique(np.concatenate([[lo, hi], at[(at > lo) & (at < hi)]]))
+    at = _jump_times(result)
+    inside = at[np.searchsorted(at, lo, side="right"): np.searchsorted(at, hi, side="left")]
+    return np.concatenate([[lo], inside, [hi]])
 
 
 def gauss_panels(a: np.ndarray, b: np.ndarray, panel: float, decay: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

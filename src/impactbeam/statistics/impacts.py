@@ -48,8 +48,8 @@ from typing import Any
 
 import numpy as np
 
-from ..result.metrics import contact_forces, per_state, pushing_parts
-from ..result.timegrid import cuts, gauss_panels, gauss_rule, solution_rates
+from ..result.metrics import contact_forces, pushing_parts
+from ..result.timegrid import cuts, gauss_panels, gauss_rule, per_state, solution_rates
 from .window import analysis_window
 
 __all__ = ["ImpactStatistics", "impact_statistics", "IMPACT_UNITS"]
