@@ -32,6 +32,7 @@ API_MODULES = (
     "impactbeam.result.files",
     "impactbeam.result.metrics",
     "impactbeam.result.stress",
+    "impactbeam.result.timegrid",
     "impactbeam.plot",
     "impactbeam.plot.response",
     "impactbeam.plot.study",
