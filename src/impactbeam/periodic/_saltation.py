@@ -173,9 +173,10 @@ class _Field:
 
     def force(self, s: int, kp: int, t: float) -> np.ndarray:
         """Modal load of slot ``s`` under load piece ``kp`` at time ``t`` (as the engine's segment set-up)."""
+        from ..solver._loop import load_value
+
         pk = self.pk
-        tau = t - self.pt0[kp]
-        u = self.pconst[kp] + self.pslope[kp] * tau + self.pamp[kp] * math.sin(self.pOm[kp] * tau + self.pphase[kp])
+        u = load_value(kp, t, self.pt0, self.pconst, self.pslope, self.pamp, self.pOm, self.pphase)
         F = pk.pw[s] * u + pk.pre[s]
         mask = int(pk.smask[s])
         for c in range(self.gap.size):
@@ -337,10 +338,8 @@ def _restored(fld: _Field, j: int, x: np.ndarray, recorded: list[int]) -> list[i
     ``j``) to the start of segment ``j + 1`` (to 1e-9 of its norm): the
     recorded ones, else with one or two pairs ``(c, c)`` inserted.
     """
-    from ..solver.ritz_space import RitzStateSpace
-
     sol, pk = fld.sol, fld.pk
-    if isinstance(pk.space, RitzStateSpace):  # exact changes of basis: a pair is no jump at all
+    if not pk.space.per_state:  # exact changes of basis: a pair is no jump at all
         return recorded
     s, after = int(sol.slot[j]), int(sol.slot[j + 1])
     target = fld.end_state(j + 1, at_start=True)

@@ -362,10 +362,11 @@ def periodic_orbit(
     else:
         res, end, n_modes = _settle(scenario, M, settle_periods)
         sol = res.solution
-        from ..solver.ritz_space import RitzStateSpace
+        from ..result.timegrid import per_state as per_state_modes
 
         # per-state modes (solver.basis = "paper", or a beam that can move as a rigid body)
-        prefer_free = not isinstance(sol.packed.space, RitzStateSpace) or bool(np.any(sol.packed.dash > 0.0))
+        per_state = per_state_modes(res)
+        prefer_free = per_state or bool(np.any(sol.packed.dash > 0.0))
         phase, free = _section_phase(sol, end - M / f, end, float(exc.start), f, prefer_free)
         pmap = StroboscopicMap(scenario, M, phase, n_modes)
         k0 = math.ceil(f * (end - exc.start) - M - phase - 1e-9)
@@ -375,7 +376,6 @@ def periodic_orbit(
         x = to_free(sol.packed, int(sol.slot[j])) @ np.concatenate([smp.eta[0], smp.eta_t[0]])
         notes: list[str] = []
         released = [i for i in range(len(scenario.contactors)) if i not in sol.engaged(j)]
-        per_state = not isinstance(sol.packed.space, RitzStateSpace)
         if not free and (per_state or _compressed(sol, released, t_s)):  # (the shared basis: exact in contact)
             notes.append(f"periodic orbit: the settling run has no free flight in its last {M} forcing period(s), "
                          "so the section lies inside a contact, where the map's start (modal coordinates of the "

@@ -168,11 +168,9 @@ def per_state(result: ResultLike) -> bool:
     result : SimulationResult
         Of the exact engine or of the ``solve_ivp`` path.
     """
-    from ..solver.ritz_space import RitzStateSpace
-
     sol = result.solution  # the exact solution's packed problem, or the solve_ivp path's integrator
     space = getattr(getattr(sol, "packed", None), "space", None) or getattr(getattr(sol, "ref", None), "space", None)
-    return space is not None and not isinstance(space, RitzStateSpace)
+    return bool(getattr(space, "per_state", False))
 
 
 def _jump_times(result: ResultLike) -> np.ndarray:

@@ -137,6 +137,9 @@ class RitzStateSpace(ProblemSpace):
     coordinates between two states (orthogonal), not the projection of eq. (12).
     """
 
+    #: One basis shared by every state: a switch changes coordinates exactly, it moves no state.
+    per_state = False
+
     def __init__(
         self,
         beam: Beam,

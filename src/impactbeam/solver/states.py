@@ -122,6 +122,9 @@ class ProblemSpace:
         A constant load acting throughout (``[preload]``).
     """
 
+    #: Whether each state has its own modes, so that a switch projects the state (paper eq. 12): the subclasses say.
+    per_state: bool
+
     def __init__(
         self,
         beam: Beam,
@@ -189,6 +192,9 @@ class ProblemSpace:
 
 class StateSpace(ProblemSpace):
     """Builds and caches the states of one problem (the paper's per-state modes) and the projections between them."""
+
+    #: Every state has its own modes: a switch moves the state by the projection of paper eq. (12).
+    per_state = True
 
     def state(self, engaged: tuple[int, ...]) -> StateModel:
         st = self._states.get(engaged)
