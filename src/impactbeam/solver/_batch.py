@@ -25,7 +25,7 @@ from ._codes import CASE_DONE
 from ._dense import dense_work
 from ._jit import njit
 from ._loop import (
-    CHATTER, CHECKPOINT, DONE, F_LAST_T, F_T, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T, I_EVALS, I_JUST, I_NEV, I_NJUMP,
+    CHATTER, CHECKPOINT, DONE, F_E_PEAK, F_E_SUM, F_LAST_T, F_T, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T, I_EVALS, I_JUST, I_NEV, I_NJUMP,
     I_NSEG, I_NSLOTS, I_NTR, I_PENDING, I_WARN_C, I_WARN_N, run,
 )
 from ._metrics import run_metrics
@@ -118,6 +118,8 @@ def run_batch(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_f
         out_warn[k, 3] = fc[F_WARN_MOVED]
         out_warn[k, 4] = fc[F_WARN_SCALE]
         out_warn[k, 5] = ic[I_NJUMP]
+        out_warn[k, 6] = fc[F_E_SUM]
+        out_warn[k, 7] = fc[F_E_PEAK]
         t_end = T_end[k] if st == DONE else t_stop
         run_metrics(seg_t0[:nseg], seg_t1[:nseg], seg_s[:nseg], seg_k[:nseg], seg_eta[:nseg], seg_deta[:nseg],
                     ev_t[:nev], ev_kind[:nev], ev_c[:nev], ev_d[:nev], nev, jumps[:ic[I_NJUMP]], t_end, reg, dec,

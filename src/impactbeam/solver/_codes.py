@@ -12,8 +12,8 @@ from __future__ import annotations
 __all__ = ["DONE", "CHATTER", "NEED_STATE", "NEED_TRANSFER", "NEED_SPACE", "CHECKPOINT", "CASE_DONE",
            "I_SLOT", "I_PIECE", "I_JUST", "I_PENDING", "I_NSEG", "I_NEV", "I_NJUMP", "I_NSLOTS", "I_NTR",
            "I_WARN_C", "REQ_A", "REQ_B", "I_RESUME", "I_EVALS", "I_SAME", "I_WARN_N", "I_USED", "N_INT",
-           "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "N_FLOAT", "MOVED_WARN",
-           "MOVED_FLOOR", "TOUCH"]
+           "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "F_E_SUM", "F_E_PEAK", "N_FLOAT",
+           "MOVED_WARN", "MOVED_FLOOR", "ENERGY_WARN", "TOUCH"]
 
 DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
 CASE_DONE = 6  # a batch finished a case and stops after each (a continuation)
@@ -23,11 +23,17 @@ I_WARN_C, REQ_A, REQ_B, I_RESUME, I_EVALS, I_SAME, I_WARN_N, I_USED = 9, 10, 11,
 N_INT = 17
 # float carry
 F_T, F_LAST_T, F_WARN_T, F_WARN_MOVED, F_WARN_SCALE, F_TAU = 0, 1, 2, 3, 4, 5
-N_FLOAT = 6
+F_E_SUM, F_E_PEAK = 6, 7  # the switches' |energy changes| summed, and the largest energy before or after one
+N_FLOAT = 8
 # a switch whose projection moves a contactor's deflection by more than MOVED_WARN of its scale (the larger of
 # its gap and deflection, at least MOVED_FLOOR touch tolerances: 1e-6 L, for a zero gap at rest) is counted
 # and warned about (engine.projection_warning), by the engine and the solve_ivp path alike
 MOVED_WARN = 0.05
 MOVED_FLOOR = 1e6
+# switches whose projections change the N-mode model's energy by more than ENERGY_WARN of the largest energy at a
+# switch, their changes' magnitudes summed, are warned about (engine.energy_warning): with per-state modes too
+# few for a stiff stop, the projections (paper eq. 12) gain or lose energy at every impact, and the impact
+# count and forces go wrong before any single switch moves a deflection by MOVED_WARN
+ENERGY_WARN = 0.05
 # the touch tolerance, as a fraction of the beam's length: a row within TOUCH L of its surface touches it (tol_h)
 TOUCH = 1e-12

@@ -69,9 +69,9 @@ from ._elementary import kernel_work
 from ._events import departure, scan
 
 from ._codes import (  # noqa: E402 - status codes and the carry's layout, shared with the Python side
-    CHATTER, CHECKPOINT, DONE, F_LAST_T, F_T, F_TAU, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T, I_EVALS, I_JUST, I_NEV,
-    I_NJUMP, I_NSEG, I_NSLOTS, I_NTR, I_PENDING, I_PIECE, I_RESUME, I_SAME, I_SLOT, I_USED, I_WARN_C, I_WARN_N,
-    MOVED_FLOOR, MOVED_WARN, NEED_SPACE, NEED_STATE, NEED_TRANSFER, REQ_A, REQ_B,
+    CHATTER, CHECKPOINT, DONE, F_E_PEAK, F_E_SUM, F_LAST_T, F_T, F_TAU, F_WARN_MOVED, F_WARN_SCALE, F_WARN_T,
+    I_EVALS, I_JUST, I_NEV, I_NJUMP, I_NSEG, I_NSLOTS, I_NTR, I_PENDING, I_PIECE, I_RESUME, I_SAME, I_SLOT, I_USED,
+    I_WARN_C, I_WARN_N, MOVED_FLOOR, MOVED_WARN, NEED_SPACE, NEED_STATE, NEED_TRANSFER, REQ_A, REQ_B,
 )
 
 KMAX = 5  # highest derivative used to judge a tangency
@@ -192,6 +192,8 @@ def _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm,
         ev_d[nev] = pen
         ic[I_NEV] = nev + 1
     phase[c] = 1 if (not engaging and dash[c] > 0.0 and pen > tol_h) else 0
+    if engaging and t == 0.0 and pen > 0.0:  # a contact under way at the start: its spring's energy is the
+        E_before += 0.5 * kst[c] * pen * pen  # initial state's, no change made by the switch
     e1 = work[1, :nm]
     d1 = work[2, :nm]
     T = Tm[k]
@@ -229,7 +231,10 @@ def _switch(fc, ic, eta, deta, own_e, own_d, smask, gen, omo, Wc, LW, CW, H, Tm,
             lossy = True
     if lossy:
         ic[I_WARN_N] += 1
-    jumps[ic[I_NJUMP]] = energy(new_mask, own_e, own_d, omo[ns], Wc[ns], gap, side, kst) - E_before
+    E_after = energy(new_mask, own_e, own_d, omo[ns], Wc[ns], gap, side, kst)
+    jumps[ic[I_NJUMP]] = E_after - E_before
+    fc[F_E_SUM] += abs(E_after - E_before)
+    fc[F_E_PEAK] = max(fc[F_E_PEAK], E_before, E_after)
     ic[I_NJUMP] += 1
     ic[I_SLOT] = ns
     ic[I_JUST] = c

@@ -167,7 +167,7 @@ def integrate_batch(
     out = np.full((n, K.N_SCALARS), np.nan)
     status = np.full(n, -1, dtype=np.int64)
     t_stop = np.zeros(n)
-    warn = np.zeros((n, 6))
+    warn = np.zeros((n, 8))
     failed: dict[int, BaseException] = {}
 
     def table_rows() -> tuple[np.ndarray, ...]:
@@ -235,7 +235,7 @@ def integrate_batch(
             moved = (int(warn[k, 0]), int(warn[k, 5]), options[k].modes, int(warn[k, 1]), float(warn[k, 3]),
                      float(warn[k, 4]), float(warn[k, 2]))
         warnings.append(run_warnings(int(status[k]), float(t_stop[k]), int(out[k, 8]), float(options[k].end_time),
-                                     moved))
+                                     moved, (float(warn[k, 6]), float(warn[k, 7]), int(warn[k, 5]), options[k].modes)))
     return BatchResult(out, status, t_stop, messages, warnings, errors)
 
 

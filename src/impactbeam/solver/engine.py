@@ -432,7 +432,8 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take: bool
     if ic[_loop.I_WARN_N]:
         moved = (int(ic[_loop.I_WARN_N]), njump, options.modes, int(ic[_loop.I_WARN_C]),
                  float(fc[_loop.F_WARN_MOVED]), float(fc[_loop.F_WARN_SCALE]), float(fc[_loop.F_WARN_T]))
-    warnings = run_warnings(code, t_stop, nev, float(options.end_time), moved)
+    warnings = run_warnings(code, t_stop, nev, float(options.end_time), moved,
+                            (float(fc[_loop.F_E_SUM]), float(fc[_loop.F_E_PEAK]), njump, options.modes))
     rec.taken = take and nseg > _TAKE and 2 * nseg > rec.seg_t0.size  # large and mostly used: no copy
 
     def out(a: np.ndarray) -> np.ndarray:
@@ -461,18 +462,36 @@ def stop_message(status: int, t_stop: float, n_events: int) -> str:
 
 
 def run_warnings(status: int, t_stop: float, n_events: int, end_time: float,
-                 moved: tuple | None = None) -> list[str]:
+                 moved: tuple | None = None, energy: tuple | None = None) -> list[str]:
     """The warnings of a run, for the single run, the batch and the ``solve_ivp`` path alike.
 
     The projection's (``moved``: the arguments of :func:`projection_warning`,
-    None when no switch moved a contactor's deflection that much), and a stop
-    by the chattering guard (``status`` 1), whose results cover only ``[0, t_stop]``.
+    None when no switch moved a contactor's deflection that much), the
+    projections' energy changes (``energy``: the arguments of
+    :func:`energy_warning`), and a stop by the chattering guard (``status``
+    1), whose results cover only ``[0, t_stop]``.
     """
     out = [] if moved is None else [projection_warning(*moved)]
+    if energy is not None and energy[0] > _loop.ENERGY_WARN * energy[1]:
+        out.append(energy_warning(*energy))
     if status == 1:
         out.append(f"{stop_message(status, t_stop, n_events)} The results cover 0 to {t_stop:.6g} s of the "
                    f"{end_time:.6g} s asked: metrics are of that part, later samples are NaN.")
     return out
+
+
+def energy_warning(changed: float, peak: float, switches: int, modes: int) -> str:
+    """The warning of switches whose projections changed the model's energy by more than ``ENERGY_WARN`` in all.
+
+    ``changed`` is the sum of the magnitudes of the energy changes at the
+    ``switches`` switches, ``peak`` the largest energy before or after one.
+    """
+    return (
+        f"the projections onto {modes} modes at the {switches} switches changed the model's energy by "
+        f"{changed:.3g} J in all ({100 * changed / peak:.0f} % of the largest energy at a switch, {peak:.3g} J; "
+        f"more than {100 * _loop.ENERGY_WARN:g} %): too few per-state modes for these contactors' stiffness, "
+        "the impacts (their forces, penetrations, even their count) are not converged; add modes."
+    )
 
 
 def projection_warning(count: int, switches: int, modes: int, contactor: int, moved: float, scale: float,

@@ -312,6 +312,7 @@ class _Reference:
         events: list[Event] = []
         segments: list[IvpSegment] = []
         jumps: list[float] = []
+        e_peak = 0.0  # the largest energy before or after a switch
         status, message = 0, "The simulation reached end_time."
         nc = len(self.contactors)
         same_instant: dict[int, int] = {}
@@ -399,13 +400,17 @@ class _Reference:
                     pens.append(self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c])
                 pen = self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c]
                 phase[c] = kind == "rebound" and self.dash[c] > 0.0 and pen > self.tol
+                if kind == "impact" and t == 0.0 and pen > 0.0:  # a contact under way at the start: the engine's
+                    E_before += 0.5 * self.stiff[c] * pen * pen  # rule (its spring's energy is the initial state's)
                 P = self.space.transfer(new, engaged, self.opt.projection == "contact")
                 w_before = st.W_contact @ eta
                 eta, deta = P @ eta, P @ deta
                 engaged = new
                 just = c
                 moved.record(t, w_before, self.space.state(new).W_contact @ eta)
-                jumps.append(self.energy(self.space.state(new), eta, deta) - E_before)
+                E_after = self.energy(self.space.state(new), eta, deta)
+                jumps.append(E_after - E_before)
+                e_peak = max(e_peak, E_before, E_after)
                 if len(events) >= self.opt.max_events or same_instant[c] > 4:
                     status = 1
                     why = "solver.max_events" if len(events) >= self.opt.max_events else (
@@ -415,8 +420,10 @@ class _Reference:
                         "chattering contact; the solution ends there."
                     )
                     break
+        changes = (float(np.sum(np.abs(jumps))), e_peak, len(jumps), self.opt.modes)  # engine.energy_warning's
         return IvpSolution(self, segments, events, np.asarray(jumps, dtype=float), status, message,
-                           t if status else T, np.asarray(pens, dtype=float), moved.worst(len(jumps), self.opt.modes))
+                           t if status else T, np.asarray(pens, dtype=float), moved.worst(len(jumps), self.opt.modes),
+                           changes)
 
 
 class _Moved:

@@ -67,7 +67,7 @@ class IvpSolution(PiecewiseSolution):
     """
 
     def __init__(self, ref: Any, segments, events, jumps, status, message, t_end, penetrations,
-                 moved: tuple | None = None) -> None:
+                 moved: tuple | None = None, energy: tuple | None = None) -> None:
         self.ref = ref
         self.segments = segments
         self.events = events
@@ -75,7 +75,7 @@ class IvpSolution(PiecewiseSolution):
         self.event_penetrations = penetrations
         self.status = status
         self.message = message
-        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time), moved))
+        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time), moved, energy))
         self.t_end = t_end
         self.contactors = ref.contactors
         self.dashpots = ref.dash
