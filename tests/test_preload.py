@@ -123,6 +123,35 @@ def test_a_contact_under_way_at_the_start_is_no_energy_change(method):
     assert res.warnings == ()
 
 
+def _pinned_on_a_stiff_stop(basis: str, modes: int) -> ib.Scenario:
+    return ib.parse_scenario({
+        "beam": {"length": 1.0, "width": 0.02, "height": 0.01, "youngs_modulus": 2e11, "density": 7800.0},
+        "supports": {"left": "pinned", "right": "free"},
+        "contactors": [{"position": 0.9, "stiffness": 1e6, "gap": 2e-4, "side": "below"}],
+        "preload": {"kind": "base_acceleration", "amplitude": "2 g"}, "initial": {"equilibrium": True},
+        "solver": {"modes": modes, "end_time": 0.005, "time_step": 1e-4, "basis": basis}})
+
+
+def test_an_equilibrium_with_wrong_contact_forces_is_warned():
+    # A pinned-free beam resting on a 1e6 N/m stop at 0.9 L under 2 g: statics gives the stop q L / 1.8 =
+    # 16.998 N. The paper's basis with 10 modes puts it 8.8 % low while its deflection is within 0.099 % (kinetic
+    # norm) of the exact one, under the 0.1 % the warning had looked at alone; with 4 modes its contact states
+    # are inconsistent and it has none, which was refused as if the beam had no support. The default basis is
+    # exact (16.998 N to 1e-9 at 4 modes).
+    sc = _pinned_on_a_stiff_stop("enriched", 4)
+    exact = continuum_equilibrium(sc.beam, sc.preload, sc.contactors).forces[0]
+    assert exact == pytest.approx(7800 * 0.02 * 0.01 * 2 * 9.80665 / 1.8, rel=1e-9)
+    with pytest.warns(ImpactBeamWarning, match=r"contact forces 8\.\d+ %"):
+        res = ib.simulate(_pinned_on_a_stiff_stop("paper", 10))
+    assert res.metrics(impacts=False)["max_penetration"] * 1e6 == pytest.approx(0.912 * exact, rel=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ImpactBeamWarning)
+        res = ib.simulate(_pinned_on_a_stiff_stop("enriched", 4))
+    assert res.metrics(impacts=False)["max_penetration"] * 1e6 == pytest.approx(exact, rel=1e-9)
+    with pytest.raises(ParameterError, match="4-mode model has no consistent static contact state.*add modes"):
+        ib.simulate(_pinned_on_a_stiff_stop("paper", 4))
+
+
 def test_lcp_and_enumeration_agree_with_two_stops():
     # Reason: the LCP (NNLS) and the enumeration of engaged sets are two solutions of one complementarity
     # problem, and the continuum's LCP a third: a tip force engages nothing, the near stop (smaller gap, more

@@ -264,6 +264,16 @@ def modal_equilibrium(space, beam: Beam, preload: Preload, contactors: Sequence[
             eq = _state_solution(space, beam, preload, contactors, engaged, tol)
             if eq is not None:
                 return eq
+    try:
+        exact = continuum_equilibrium(beam, preload, contactors)
+    except ParameterError:
+        exact = None
+    if exact is not None:  # the beam has one: the truncated model's contact states are not consistent
+        raise ParameterError(
+            f"initial.equilibrium: the run's {space.n_modes}-mode model has no consistent static contact state "
+            f"under the preload, though the beam has one (contactors {list(exact.engaged)} engaged): too few "
+            "modes for these contactors' stiffness; add modes"
+        )
     raise ParameterError(
         "initial.equilibrium: no static equilibrium exists under the preload: the supports and the contactors "
         "it engages do not hold the beam (it would move as a rigid body, e.g. a free-free beam under gravity); "
@@ -317,8 +327,8 @@ def continuum_equilibrium(beam: Beam, preload: Preload, contactors: Sequence[Con
     a = [c.position for c in contactors]
     try:
         lam = np.zeros(len(contactors))
+        w0 = static_state(beam, a or [0.0], loads, per_length)[0]  # refused when the supports let the beam move
         if contactors:
-            w0 = static_state(beam, a, loads, per_length)[0]
             F = np.array([static_state(beam, a, [(aj, 1.0)])[0] for aj in a]).T  # F[i, j]: w(a_i) per unit force at a_j
             lam = _lcp(s[:, None] * F * s[None, :], s * w0 - gap, k)
         engaged = tuple(int(i) for i in np.flatnonzero(lam > 0.0))

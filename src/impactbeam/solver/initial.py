@@ -229,8 +229,9 @@ def _to_free(space, engaged: tuple[int, ...], vectors: Sequence[np.ndarray], pre
 
 
 def _truncation(space, beam: Beam, preload: Preload, contactors: Sequence[Contactor], engaged: tuple[int, ...],
-                eta: np.ndarray) -> None:
-    """Warn when the modal equilibrium differs from the exact static contact solution by more than RESIDUAL_WARNING."""
+                eta: np.ndarray, forces: np.ndarray) -> None:
+    """Warn when the modal equilibrium differs from the exact static contact solution by more than RESIDUAL_WARNING:
+    its deflection (relative kinetic norm) or its contact forces (relative to the largest exact one)."""
     try:
         exact = continuum_equilibrium(beam, preload, contactors)
     except ParameterError:  # the model holds the beam, the continuum does not: certainly truncated
@@ -250,11 +251,15 @@ def _truncation(space, beam: Beam, preload: Preload, contactors: Sequence[Contac
     m = beam.mass_per_length_at(x_q) * w_q
     norm = math.sqrt(float(np.sum(m * u * u)))
     miss = math.sqrt(float(np.sum(m * diff * diff)))
-    if exact.engaged != tuple(engaged) or (norm > 0.0 and miss > RESIDUAL_WARNING * norm):
+    top = float(np.max(np.abs(exact.forces), initial=0.0))
+    force_miss = float(np.max(np.abs(np.asarray(forces) - exact.forces), initial=0.0))
+    if (exact.engaged != tuple(engaged) or (norm > 0.0 and miss > RESIDUAL_WARNING * norm)
+            or force_miss > RESIDUAL_WARNING * top):
         emit_user_level_warning(
             f"initial.equilibrium: the run's {modes.count}-function model puts the static equilibrium "
-            f"{100 * miss / max(norm, 1e-300):.3g} % (relative kinetic norm) from the exact static solution "
-            f"(contactors engaged: model {list(engaged)}, exact {list(exact.engaged)}); add modes"
+            f"{100 * miss / max(norm, 1e-300):.3g} % (relative kinetic norm) from the exact static solution, "
+            f"its contact forces {100 * force_miss / max(top, 1e-300):.3g} % of the largest exact one (contactors "
+            f"engaged: model {list(engaged)}, exact {list(exact.engaged)}); add modes"
         )
 
 
@@ -304,7 +309,7 @@ def initial_coordinates(
             raise ParameterError("initial.equilibrium: needs a preload (the constant load the equilibrium is taken under)")
         eq = modal_equilibrium(space, beam, preload, contactors)
         engaged, eta_s = eq.engaged, eq.eta.copy()
-        _truncation(space, beam, preload, contactors, engaged, eta_s)
+        _truncation(space, beam, preload, contactors, engaged, eta_s, eq.forces)
     modes = space.state(engaged).modes
     breaks = [float(p) for p in space.positions]
     for profile in (initial.displacement_profile, initial.velocity_profile):
