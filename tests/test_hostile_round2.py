@@ -137,6 +137,21 @@ CASES = [
      "--workers: 1000 worker processes would need about 250 GiB"),
     ("frequency-scale-1e60", ["modes", "s.toml"], {"s.toml": BEAM.replace("length = 0.1092", "length = 1e-30")}, 2,
      "beam.length: 1e-30 gives a frequency scale"),
+    # round three: silent misreadings, a traceback, runs that never ended (and ignored Ctrl-C)
+    ("gap-decimal-comma", ["simulate", "s.toml"], {"s.toml": _set(CASE3, "gap", '"0,229 mm"')}, 2,
+     'contactors.0.gap: cannot read "0,229 mm": expected one number'),
+    ("gap-thousands-blank", ["simulate", "s.toml"], {"s.toml": _set(CASE3, "gap", '"229 000 nm"')}, 2,
+     '"000 nm" is not a unit'),
+    ("ratio-in-degrees", ["simulate", "s.toml"], {"s.toml": _set(CASE3, "position_ratio", '"0.5 deg"')}, 2,
+     'contactors.0.position_ratio: "0.5 deg" has an angle in its unit'),
+    ("max-events-1e300", ["simulate", "s.toml"], {"s.toml": CASE3 + "max_events = 1e300\n"}, 2,
+     "solver.max_events: must be a positive integer up to 2^62, got 1e+300"),
+    ("harmonic-1e300-hz", ["simulate", "s.toml"], {"s.toml": _set(HARMONIC, "frequency", "1e300")}, 2,
+     "excitation.frequency: 1e+300 Hz is above the 1e+70 rad/s"),
+    ("damping-ratio-1e300", ["simulate", "s.toml"], {"s.toml": _set(CASE3, "free", "1e300")}, 2,
+     "damping.free: a damping ratio of 1e+300 is above 1e+10"),
+    ("header-name-slash-unit", ["simulate", "s.toml"], {"s.toml": TRACE, "t.csv": "time/ms,acc/g\n0,0\n1,1\n"}, 2,
+     "cannot tell the unit of the column 'time/ms'"),
 ]
 
 

@@ -134,6 +134,9 @@ BAD = [
     ('psd = [[10, 0.1], [100, 0.1]]\nseed = -1', "excitation.seed", ">= 0"),
     ('psd = [[10, 0.1], [100, 0.1]]\namplitude = "1 g"', "excitation.amplitude", "no effect"),
     ('psd = [[10, 0.1], [100, 0.1]]\nsample_rate = "150 Hz"', "excitation.sample_rate", "twice"),
+    # absurd magnitudes: a traceback from NumPy, and a response of 1e146 m
+    ('psd = [[10, 0.1], [100, 0.1]]\nsample_rate = 1e300', "excitation.sample_rate", "load samples) would need"),
+    ('psd = [[10, 1e300], [100, 1e300]]', "excitation.psd", "would drive the beam to a deflection"),
 ]
 BAD_FATIGUE = [
     ('points = [0.2]\nsn_stress = "20 MPa"\nsn_cycles = 1e6\nsn_exponent = 8', "fatigue.points.0", "off the beam"),
@@ -143,6 +146,9 @@ BAD_FATIGUE = [
     ('points = [0.0]\nsn_stress = "20 MPa"\nsn_cycles = 1e6\nsn_exponent = 8\nmean_stress = "goodman"',
      "fatigue.ultimate_strength", "required"),
     ('points = [0.0]\nsn_stress = "20 MPa"\nsn_exponent = 8', "fatigue.sn_cycles", "required"),
+    # pint's cycle is a turn, 2 pi rad: "1e6 cycles" was a count of 6.28e6
+    ('points = [0.0]\nsn_stress = "20 MPa"\nsn_cycles = "1e6 cycles"\nsn_exponent = 8', "fatigue.sn_cycles",
+     "has an angle in its unit"),
 ]
 
 _HEAD = """

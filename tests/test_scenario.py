@@ -158,9 +158,23 @@ def test_to_si(value: object, dimension: str, expected: float) -> None:
         ("inf", "length", "finite"),
         (math.inf, "time", "finite"),
         ("15 gee", "acceleration", "cannot read"),
-        ("mm", "length", "expected a number"),
+        ("mm", "length", "expected one number"),
         (True, "length", "expected a number"),
         ([1.0], "length", "got a list"),
+        # one number and a unit: a decimal comma, a thousands separator or arithmetic was read as another
+        # number ("0,229 mm" as 0, "1 000 um" as 0, "2 m + 1 m" as 4 m, "1.5.3 mm" as 0.45 mm)
+        ("0,229 mm", "length", "expected one number"),
+        ("1 000 um", "length", '"000 um" is not a unit'),
+        ("2 m + 1 m", "length", "is not a unit"),
+        ("15 g + 1 g", "acceleration", "is not a unit"),
+        ("1.5.3 mm", "length", "expected one number"),
+        # an angle where the dimension has none (pint takes the radian as dimensionless): "0.5 deg" was a
+        # position ratio of 0.0087, "1e6 cycles" a count of 6.28e6, "100 %" an angle of 1 rad
+        ("0.5 deg", "dimensionless", "has an angle in its unit"),
+        ("1e6 cycles", "dimensionless", "has an angle in its unit"),
+        ("1 rpm", "rate", "has an angle in its unit"),
+        ("100 %", "angle", "has no angle in its unit"),
+        ("1 1/s", "angular_velocity", "has no angle in its unit"),
     ],
 )
 def test_to_si_rejects(value: object, dimension: str, match: str) -> None:
@@ -578,8 +592,27 @@ def test_common_unit_table_agrees_with_pint():
     from impactbeam import units
 
     for (unit, dimension), factor in units.COMMON_UNITS.items():
-        q = units._parse(unit, dimension)
+        q = units._parse_unit(unit, dimension, unit)
         assert units._quantity_to_si(q, unit, dimension) == factor, (unit, dimension)
+
+
+@pytest.mark.parametrize(("value", "dimension", "si"), [
+    # a cycle is 2 pi rad where frequencies meet angles (the rule of frequencies: Hz counts cycles)
+    ("1 N^2/(rad/s)", "force_psd", 2 * math.pi),  # S(f) = 2 pi S(omega); was read as 1 N^2/Hz
+    ("1 (m/s^2)^2/(rad/s)", "acceleration_psd", 2 * math.pi),
+    ("1 Hz", "angular_velocity", 2 * math.pi),  # was 1 rad/s, while "1 cycle/s" gave 2 pi
+    ("1 cycle/s", "angular_velocity", 2 * math.pi),
+    ("60 rpm", "angular_velocity", 2 * math.pi),
+    ("90 deg", "angle", math.pi / 2),
+    ("5 N*m", "rotational_stiffness", 5.0),  # its radian may be left out
+    ("5 N*m/deg", "rotational_stiffness", 5.0 * 180 / math.pi),
+    ("85 %", "dimensionless", 0.85),
+    ("2/s", "rate", 2.0),
+    ("5*mm", "length", 5e-3),
+    ("1 mm^4", "second_moment", 1e-12),  # pint's factor is 1.0000000000000002e-12: rounded to its decimal
+])
+def test_to_si_keeps_the_angles_in_units(value: str, dimension: str, si: float) -> None:
+    assert to_si(value, dimension, "k") == pytest.approx(si, rel=1e-15)
 
 
 @pytest.mark.parametrize(

@@ -77,6 +77,16 @@ def test_trace_in_ms_and_g_simulates_like_si(tmp_path: Path, header: str) -> Non
             assert vb == va, key
 
 
+@pytest.mark.parametrize("unit", ["[mm/(s^2)]", "(mm/(s^2))", "[mm/s^2]"])
+def test_a_unit_with_parentheses_in_a_header_is_honoured(tmp_path: Path, unit: str) -> None:
+    # "acc [mm/(s^2)]" did not match the header pattern: the whole cell became the column's name and the
+    # values were read as m/s^2, 1000 times too large, in silence
+    (tmp_path / "t.csv").write_text(f"time [ms],acc {unit}\n0,0\n1,1500\n2,0\n")
+    (tmp_path / "s.toml").write_text(SCENARIO.format(file="t.csv"))
+    ex = ib.load_scenario(tmp_path / "s.toml").excitation
+    assert list(ex.times) == [0.0, 0.001, 0.002] and list(ex.values) == [0.0, 1.5, 0.0]
+
+
 def test_trace_and_record_read_the_same_numbers(tmp_path: Path) -> None:
     """The scenario trace and load_record give identical SI arrays from one file."""
     user = _write_traces(tmp_path, "time,acceleration", "time (ms),acceleration (g)")[1]

@@ -60,7 +60,7 @@ __all__ = [
     "to_jsonable", "json_text", "RESULT_SUFFIXES", "PLOT_SUFFIXES", "check_output", "check_writable",
     "WriteError", "write_error", "atomic_path", "write_text", "write_bytes", "write_netcdf", "pid_alive",
     "read_text_file", "TEXT_MEMORY_FACTOR",
-    "HEADER_CELL", "DelimitedText", "numeric_columns", "read_data_lines", "read_delimited",
+    "HEADER_CELL", "header_cell", "DelimitedText", "numeric_columns", "read_data_lines", "read_delimited",
 ]
 
 # --------------------------------------------------------------------------- JSON
@@ -314,10 +314,36 @@ def write_netcdf(dataset: Any, path: str | os.PathLike[str]) -> None:
 
 # --------------------------------------------------------------------------- delimited text
 
-#: A header cell: a name and an optional unit in brackets or parentheses.
-HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\[\]()]*)[\])])?\s*$")
+# a unit in brackets (parentheses allowed inside: "[mm/(s^2)]") or in parentheses (one level inside: "(mm/(s^2))")
+_UNIT_GROUP = r"(?:\[[^\[\]]*\]|\((?:[^()]|\([^()]*\))*\))"
+#: A header cell: a name and an optional unit in brackets or parentheses, at its end.
+HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?P<group>" + _UNIT_GROUP + r")?\s*$")
 
-_BLANK_HEADER = re.compile(r"[^\s\[\]()]+(?:\s*[\[(][^\[\]()]*[\])])?|[\[(][^\[\]()]*[\])]")
+_BLANK_HEADER = re.compile(r"[^\s\[\]()]+(?:\s*" + _UNIT_GROUP + r")?|" + _UNIT_GROUP)
+
+
+def header_cell(cell: str) -> tuple[str, str | None]:
+    """The name and the unit (None when none is given) of a header cell such as ``acc [mm/(s^2)]``.
+
+    Parameters
+    ----------
+    cell : str
+        The cell's text.
+
+    Returns
+    -------
+    (name, unit)
+        ``unit`` is None for a cell without one; a cell whose unit cannot be
+        told (a bracket left open, ``time/ms``) raises ValueError instead of
+        passing for a name, which would read its column as SI.
+    """
+    m = HEADER_CELL.match(cell)
+    name = (m.group("name") if m else cell).strip()
+    group = m.group("group") if m else None
+    if group is None and any(ch in cell for ch in "[]()/"):
+        raise ValueError(f"cannot tell the unit of the column {cell.strip()!r}: write it after the name in "
+                         "brackets, e.g. 'time [ms]'")
+    return name or cell.strip(), None if group is None else group[1:-1].strip()
 
 
 #: Peak memory of reading a text table, per byte of the file (the text, its lines, their cells
@@ -522,11 +548,12 @@ def read_delimited(
     if header:
         names, units = [], []
         for cell in first:
-            m = HEADER_CELL.match(cell)
-            name = (m.group("name") if m else cell).strip() or cell.strip()
-            unit = m.group("unit") if m else None
+            try:
+                name, unit = header_cell(cell)
+            except ValueError as exc:
+                raise fail(f"line {n0}: {exc}") from None
             names.append(name)
-            units.append(unit.strip() if unit is not None else None)
+            units.append(unit)
         rows = lines[1:]
     else:
         names = ["time"] + [f"column {j}" for j in range(2, len(first) + 1)]

@@ -115,10 +115,10 @@ _KNOWN_DIMENSIONALITIES: tuple[tuple[str, str], ...] = (
 )
 
 _UREG: Any = None
-_NUMBER_START = re.compile(r"^\s*[-+]?(\d|\.\d)")
+# one number (a decimal point, no separators: "0,229 mm" and "1 000 um" are refused, not read as 0), then the unit
 _NUMBER_UNIT = re.compile(
-    r"^\s*(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?i:inf(?:inity)?|nan))(?![\d.])"
-    r"\s*(?P<unit>[^\s*/^].*?)\s*$"
+    r"^\s*(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?i:inf(?:inity)?|nan))(?![\d.,])"
+    r"\s*(?P<unit>\S.*?)\s*$"
 )
 _GRAVITY_G = re.compile(r"(?<![\w.])g(?![\w.])")
 
@@ -194,8 +194,22 @@ def _name_of(dimensionality: Any) -> str:
     return f"of dimension {dimensionality}"
 
 
+#: Dimensions whose SI unit holds an angle (rad), as the power of the radian in it.
+_ANGLE_POWER = {"angle": 1, "angular_velocity": 1, "rotational_stiffness": -1}
+_PSDS = {"acceleration_psd", "force_psd", "force_per_length_psd"}
+
+
 def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
-    """Convert a pint quantity to the SI unit of ``dimension``."""
+    """Convert a pint quantity to the SI unit of ``dimension``, the angles in its unit kept.
+
+    pint takes the radian as dimensionless; here an angle counts. A unit's
+    angle must be the dimension's (``"0.5 deg"`` is no position ratio, ``"1e6
+    cycles"`` no count), except that a cycle is 2 pi rad where frequencies
+    meet angles: a frequency per angle of time (:func:`_cyclic_frequency`), an
+    angular velocity in hertz (``"1 Hz"`` is 2 pi rad/s), a spectral density
+    per angular frequency (``"1 N^2/(rad/s)"`` is 2 pi N^2/Hz); and a
+    rotational stiffness may leave its radian out (``"5 N*m"``).
+    """
     ureg = registry()
     dim = _dimension(dimension)
     target = ureg.parse_units(dim.pint_unit)
@@ -205,7 +219,19 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
         )
     if dimension == "frequency":
         return _cyclic_frequency(quantity, text)
-    return float(quantity.to(target).magnitude)
+    angle = dict(quantity.to_root_units().units._units).get("radian", 0)
+    value = float(quantity.to(target).magnitude)
+    wanted = _ANGLE_POWER.get(dimension, 0)
+    if angle == wanted or (dimension == "rotational_stiffness" and angle == 0):
+        return value
+    if dimension == "angular_velocity" and angle == 0 and "hertz" in str(quantity.units):
+        return 2.0 * math.pi * value  # cycles per second
+    if dimension in _PSDS and angle == -1:
+        return 2.0 * math.pi * value  # per rad/s: S(f) = 2 pi S(omega)
+    if wanted:
+        hint = "; give it in rad/s, deg/s, rpm or Hz (revolutions)" if dimension == "angular_velocity" else ""
+        raise _UnitProblem(f'"{text}" has no angle in its unit, expected {describe_dimension(dimension)}{hint}')
+    raise _UnitProblem(f'"{text}" has an angle in its unit, expected {describe_dimension(dimension)}')
 
 
 def _cyclic_frequency(quantity: Any, text: str) -> float:
@@ -229,25 +255,23 @@ def _cyclic_frequency(quantity: Any, text: str) -> float:
     return magnitude / (2.0 * math.pi) if angle == 1 else magnitude
 
 
-def _parse(text: str, dimension: str, shown: str | None = None) -> Any:
-    """Parse ``text`` with pint (``g`` = standard gravity for accelerations).
+def _parse_unit(unit: str, dimension: str, shown: str) -> Any:
+    """One of ``unit`` as a pint quantity (``g`` = standard gravity for accelerations).
 
-    ``shown`` is the string quoted in error messages (default ``text``).
+    A unit only: a number or arithmetic in it (``"000 um"``, ``"m + 1 m"``)
+    is refused. ``shown`` is the string quoted in error messages.
     """
     ureg = registry()
-    expr = text
-    if dimension in _GRAVITY_DIMENSIONS:
-        expr = _GRAVITY_G.sub("g_0", expr)
+    expr = _GRAVITY_G.sub("g_0", unit) if dimension in _GRAVITY_DIMENSIONS else unit
     try:
-        quantity = ureg.parse_expression(expr)
-    except Exception as exc:  # pint raises many types (UndefinedUnitError, tokenize, ...)
+        units = ureg.parse_units(expr)
+    except Exception as exc:  # pint raises many types (UndefinedUnitError, tokenize, scaling factor, ...)
         detail = str(exc).strip() or type(exc).__name__
         raise _UnitProblem(
-            f'cannot read "{shown or text}" ({detail}); expected {describe_dimension(dimension)}'
+            f'cannot read "{shown}": "{unit}" is not a unit ({detail}); expected one number (a decimal point, '
+            f"no separators) and a unit, {describe_dimension(dimension)}"
         ) from None
-    if not hasattr(quantity, "dimensionality"):  # a bare number
-        quantity = ureg.Quantity(quantity)
-    return quantity
+    return ureg.Quantity(1.0, units)
 
 
 #: SI factors of the units most scenario files use, so that reading them needs no
@@ -280,7 +304,8 @@ def _unit_factor(unit: str, dimension: str, shown: str) -> float:
     if hit is None:
         hit = _FACTORS.get(key)
     if hit is None:
-        hit = _quantity_to_si(_parse(unit, dimension, shown), shown, dimension)
+        hit = _quantity_to_si(_parse_unit(unit, dimension, shown), shown, dimension)
+        hit = float(f"{hit:.15g}")  # pint's products leave round-off in decimal factors: "1 mm^4" is 1e-12 m^4
         if len(_FACTORS) < 1024:
             _FACTORS[key] = hit
     return hit
@@ -314,25 +339,27 @@ def _convert(value: Any, dimension: str) -> float:
         try:
             out = float(text)  # a number written as a string: SI
         except ValueError:
-            if not (_NUMBER_START.match(text) or _NUMBER_UNIT.match(text)):
-                raise _UnitProblem(
-                    f'cannot read "{value}": expected a number followed by a unit, '
-                    f"{describe_dimension(dimension)}"
-                ) from None
             m = _NUMBER_UNIT.match(text)
-            if m is not None:
-                # "<number> <unit>": convert the unit alone, multiply in decimal (see scale_decimal)
-                factor = _unit_factor(m.group("unit"), dimension, text)
-                number = m.group("number")
-                special = number.lower().lstrip("+-")
-                if special == "nan":
-                    out = math.nan
-                elif special.startswith("inf"):
-                    out = float(number)
-                else:
-                    out = scale_decimal(number, factor)
+            if m is None:
+                raise _UnitProblem(
+                    f'cannot read "{value}": expected one number (a decimal point, no separators) followed by a '
+                    f"unit, {describe_dimension(dimension)}"
+                ) from None
+            # "<number> <unit>": convert the unit alone, multiply in decimal (see scale_decimal)
+            unit = m.group("unit")
+            if unit.startswith("*"):  # "5*mm"
+                unit = unit[1:].lstrip()
+            elif unit.startswith("/"):  # "2/s"
+                unit = "1" + unit
+            factor = _unit_factor(unit, dimension, text)
+            number = m.group("number")
+            special = number.lower().lstrip("+-")
+            if special == "nan":
+                out = math.nan
+            elif special.startswith("inf"):
+                out = float(number)
             else:
-                out = _quantity_to_si(_parse(text, dimension), text, dimension)
+                out = scale_decimal(number, factor)
     else:
         out = float(value)
     if math.isnan(out):

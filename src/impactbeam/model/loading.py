@@ -133,6 +133,11 @@ class Excitation:
             if self.frequency is None:
                 raise ParameterError("excitation.frequency: required for a harmonic load")
             object.__setattr__(self, "frequency", positive_finite("excitation.frequency", self.frequency))
+            if 2.0 * math.pi * self.frequency > PULSE_OMEGA_LIMIT:  # its closed form forms Omega^4
+                raise ParameterError(
+                    f"excitation.frequency: {self.frequency:g} Hz is above the {PULSE_OMEGA_LIMIT:.0e} rad/s at "
+                    "which the closed form of a sinusoidal load overflows (Omega^4); check the value and its unit"
+                )
         if self.kind == "point_force":
             if self.position is None:
                 raise ParameterError("excitation.position: required for a point_force")

@@ -87,10 +87,11 @@ def response_estimates(beam: Beam, excitation: Excitation, initial: InitialCondi
     reach = min(T / omega0, 0.5 * T * T)  # metres per (m/s^2) of a load over T
     out: list[tuple[str, float]] = []
     if excitation.active:
-        peak = _largest(excitation.values) if excitation.shape == "table" else abs(excitation.amplitude)
+        sampled = excitation.shape in ("table", "random")  # a random load's samples are drawn when it is made
+        peak = _largest(excitation.values) if sampled else abs(excitation.amplitude)
         per_mass = {"base_acceleration": 1.0, "point_force": 1.0 / mass,
                     "distributed_force": beam.length / mass}[excitation.kind]
-        key = "excitation.file" if excitation.shape == "table" else "excitation.amplitude"
+        key = {"table": "excitation.file", "random": "excitation.psd"}.get(excitation.shape, "excitation.amplitude")
         if abs(excitation.scale) > 1.0 and (peak == 0.0 or abs(excitation.scale) > peak):
             key = "excitation.scale"
         span = reach

@@ -100,8 +100,12 @@ class SolverOptions:
                 f"solver.time_step: {self.end_time / self.time_step:.3g} output samples is too many "
                 f"(max {MAX_OUTPUT_SAMPLES:.0e})"
             )
-        if isinstance(self.max_events, bool) or not isinstance(self.max_events, (int, np.integer)) or self.max_events < 1:
-            raise ParameterError(f"solver.max_events: must be a positive integer, got {self.max_events!r}")
+        if (isinstance(self.max_events, bool) or not isinstance(self.max_events, (int, np.integer))
+                or not 1 <= self.max_events <= 2**62):
+            big = isinstance(self.max_events, (int, np.integer)) and not isinstance(self.max_events, bool) \
+                and self.max_events > 2**62
+            shown = f"{float(self.max_events):.3g}" if big else repr(self.max_events)
+            raise ParameterError(f"solver.max_events: must be a positive integer up to 2^62, got {shown}")
         object.__setattr__(self, "max_events", int(self.max_events))
         object.__setattr__(
             self, "event_tolerance", positive_finite("solver.event_tolerance", self.event_tolerance)

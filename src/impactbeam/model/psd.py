@@ -210,6 +210,11 @@ def sample_rate(psd: PowerSpectralDensity, requested: float | None = None) -> fl
     return rate
 
 
+#: Peak bytes per load sample of :func:`synthesize` and the run that holds it: the half spectrum and
+#: its transform, the samples, their times, the load pieces made of them.
+SAMPLE_BYTES = 64
+
+
 def synthesize(
     psd: PowerSpectralDensity,
     duration: float,
@@ -244,6 +249,10 @@ def synthesize(
     """
     T = positive_finite("excitation.duration", duration)
     fs = sample_rate(psd, rate)
+    from .._memory import check_memory
+
+    check_memory(T * fs * SAMPLE_BYTES, f"excitation.sample_rate: {fs:g} Hz over excitation.duration = {T:g} s "
+                 f"({T * fs:.3g} load samples)", "ask for a lower sample rate or a shorter history")
     n = max(int(math.ceil(T * fs)), 4)
     n += n % 2
     f_lo, f_hi = psd.band
