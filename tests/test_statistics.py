@@ -216,6 +216,19 @@ def test_ensemble_members_repeat_alone_and_sweeps_store_statistics(tmp_path):
     assert again.to_dict() == d
 
 
+def test_members_warnings_survive_a_resumed_ensemble(tmp_path):
+    # Each member of a 0.2 s ensemble warns that its statistics include the start from rest. The warnings
+    # were those issued in the process: a resumed ensemble, whose members come from the store, had none
+    # (and rewrote its summary without them). They are stored with each member now, and counted.
+    sc = ib.parse_scenario(linear_data(end_time=0.2))
+    first = ib.random_response(sc, seeds=2, workers=0, out=tmp_path / "ens")
+    mine = [w for w in first.warnings if w.startswith("2 of 2 members: statistics: the run lasts")]
+    assert len(mine) == 1 and "start from rest" in mine[0]
+    assert list(first.dataset["warnings"].values) == [mine[0].split("members: ", 1)[1]] * 2
+    again = ib.random_response(sc, seeds=2, workers=0, out=tmp_path / "ens")
+    assert again.warnings == first.warnings
+
+
 def test_bad_ensemble_input_exits_2(scenario_file):
     path = scenario_file(ib.parse_scenario(linear_data(end_time=1.0)).to_toml())
     for args, key in ((["--seeds", "0"], "--seeds"), (["--seeds", "2", "--workers", "-1"], "--workers")):

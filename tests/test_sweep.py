@@ -146,6 +146,31 @@ def test_random_cases_equal_simulate_exactly(grid_run):
         assert np.isnan(case["w"].values[~inside]).all()
 
 
+def test_each_cases_warnings_are_stored_with_it(tmp_path):
+    """The warnings of a case were issued in the process that ran it (lost on a Dask worker, and on resume)."""
+    text = f"""
+base = "{CASE3.as_posix()}"
+[parameters."contactors.0.stiffness"]
+values = [4030, 1e5]
+[parameters."solver.basis"]
+values = ["paper"]
+[parameters."solver.end_time"]
+values = [0.05]
+[outputs]
+metrics = ["n_impacts"]
+"""
+    path = _write(tmp_path, "warn.toml", text)
+    run = run_sweep(path, tmp_path / "warn.zarr", workers=0, progress=False)
+    ds = run.dataset.squeeze()
+    soft, stiff = (str(v) for v in ds["warnings"].values)
+    alone = ib.simulate(ib.load_scenario(CASE3).with_values(
+        {"contactors.0.stiffness": 1e5, "solver.basis": "paper", "solver.end_time": 0.05}))
+    assert soft == "" and stiff.splitlines() == list(alone.warnings) and "changed the model's energy" in stiff
+    out = subprocess.run([*_cli(), "sweep", str(path), "--out", str(tmp_path / "again.zarr"), "--workers", "0",
+                          "--no-progress"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0 and "1 with warnings (see the warnings variable)" in out.stderr, out.stderr
+
+
 def test_failed_case_is_recorded_and_the_sweep_goes_on(tmp_path):
     """A contactor at 0.06 m lies off a 0.05 m beam: only that combination fails."""
     text = f"""
@@ -167,7 +192,7 @@ metrics = ["max_response", "n_impacts"]
     assert "off the beam" in str(ds["message"].sel(bad).values)
     assert math.isnan(float(ds["max_response"].sel(bad)))
     assert int((ds["status"] == 0).sum()) == 3 and run.failed == 1
-    assert list(ds.data_vars) == ["max_response", "n_impacts", "status", "message"]
+    assert list(ds.data_vars) == ["max_response", "n_impacts", "status", "message", "warnings"]
     with pytest.raises(ScenarioError, match="off the beam"):
         sweep(path, None, workers=0, progress=False, on_error="raise")
 

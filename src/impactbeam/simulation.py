@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from ._warnings import emit_user_level_warning as warn
+from ._warnings import WarningLog, emit_user_level_warning as warn
 from .exceptions import ParameterError
 from .model import MAX_MODES, Damping, SolverOptions
 from .model.beam import Beam, Contactor
@@ -454,6 +454,8 @@ class CaseMetrics:
         The exception of each failed case.
     modes : ndarray of int, (n_cases,)
         Modes per state of each run (what ``solver.modes = "auto"`` chose); 0 for a failed case.
+    warnings : list of list of str
+        The warnings of each run (also issued as ImpactBeamWarning).
     """
 
     scalars: np.ndarray
@@ -461,6 +463,7 @@ class CaseMetrics:
     messages: list[str]
     errors: list[BaseException | None] = field(default_factory=list)
     modes: np.ndarray | None = None
+    warnings: list[list[str]] = field(default_factory=list)
 
 
 def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None = None) -> CaseMetrics:
@@ -493,6 +496,7 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
     modes = np.zeros(n, dtype=np.int64)
     messages = [""] * n
     errors: list[BaseException | None] = [None] * n
+    warned: list[list[str]] = [[] for _ in range(n)]
     groups: dict[tuple, list[int]] = {}
     points: dict[int, np.ndarray] = {}
     for k, c in enumerate(cases):
@@ -513,10 +517,14 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
         first = cases[ks[0]]
         if key[0] == "one":
             try:
-                res = simulate_system(first.beam, first.contactors, damping=first.damping, excitation=first.excitation,
-                                      initial=first.initial, options=first.options, points=first.points,
-                                      preload=first.preload)
-                m = res.metrics(impacts=False)
+                with WarningLog() as log:
+                    res = simulate_system(first.beam, first.contactors, damping=first.damping,
+                                          excitation=first.excitation, initial=first.initial, options=first.options,
+                                          points=first.points, preload=first.preload)
+                    m = res.metrics(impacts=False)
+                warned[ks[0]] = log.messages
+                for text in log.messages:
+                    warn(text)
             except Exception as exc:
                 errors[ks[0]] = exc
                 messages[ks[0]] = " ".join(str(exc).split())
@@ -541,12 +549,13 @@ def run_cases(cases: Sequence[Case], *, progress: Callable[[int], None] | None =
                 for j, k in enumerate(part):
                     messages[k] = br.messages[j]
                     errors[k] = br.errors[j]
+                    warned[k] = list(br.warnings[j])
                     for text in br.warnings[j]:
                         warn(text)
                 done += len(part)
         if progress is not None:
             progress(done)
-    return CaseMetrics(scalars, status, messages, errors, modes)
+    return CaseMetrics(scalars, status, messages, errors, modes, warned)
 
 
 #: Bytes of load pieces one compiled batch may hold (a batch pads every case's pieces to the longest).

@@ -77,9 +77,12 @@ def sweep_command(
         )
         sys.exit(128 + exc.signum)
     failed = "" if not run.failed else f" ({run.failed} failed: see the status and message variables)"
+    ds = run.dataset
+    warned = int((ds["warnings"] != "").sum()) if "warnings" in ds else 0
+    note = "" if not warned else f"; {warned} with warnings (see the warnings variable)"
     click.echo(
         f"sweep {spec.name}: {run.n_cases} cases, {run.computed} computed, {run.skipped} already done"
-        f"{failed}; results in {out}",
+        f"{failed}{note}; results in {out}",
         err=True,
     )
 

@@ -156,6 +156,18 @@ def _aggregate(ds: xr.Dataset, confidence: float, has_fatigue: bool) -> dict[str
     return out
 
 
+def _member_warnings(ds: xr.Dataset, seeds: int) -> list[str]:
+    """The members' warnings, each once with how many members gave it (from the store: a resumed ensemble too)."""
+    if "warnings" not in ds:  # a store made before they were recorded
+        return []
+    counts: dict[str, int] = {}
+    for text in np.asarray(ds["warnings"].values).ravel():
+        for line in dict.fromkeys(str(text).splitlines()):
+            if line:
+                counts[line] = counts.get(line, 0) + 1
+    return [f"{k} of {seeds} members: {line}" for line, k in counts.items()]
+
+
 def _stored_seed(store: Path) -> int | None:
     """The root seed of an existing ensemble store (to resume one whose scenario gave no seed)."""
     if not store.exists():
@@ -255,6 +267,7 @@ def random_response(
         warnings.append(f"{failed} of {seeds} members did not finish and are left out (first: {first})")
     if est["seeds"] < 2:
         warnings.append("fewer than two finished members: no confidence intervals")
+    warnings += _member_warnings(ds, int(seeds))
     for text in warnings:
         emit_user_level_warning(text)
     return RandomResponse(

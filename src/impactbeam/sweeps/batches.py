@@ -30,6 +30,7 @@ from itertools import product
 from typing import Any
 import numpy as np
 
+from .._warnings import WarningLog
 from ..exceptions import ImpactBeamError
 from ..scenario import parse_scenario
 from .spec import FAILED, SweepSpec, _plain, default_batch_size
@@ -283,8 +284,8 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     """Run the cases of one batch (on a worker); per-case errors are recorded.
 
     Returns a dict of arrays over the batch's cases (C order of its region):
-    one per metric, ``status``, ``message`` and, with histories, ``w``
-    (n_cases, n_times, n_points).
+    one per metric, ``status``, ``message``, ``warnings`` (each case's, one
+    per line) and, with histories, ``w`` (n_cases, n_times, n_points).
 
     Parameters
     ----------
@@ -300,6 +301,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     status = np.full(n, FAILED, dtype=np.int8)
     out["modes"] = np.zeros(n, dtype=np.int16)  # modes per state of each case (stored with solver.modes = "auto")
     message = [""] * n
+    out["warnings"] = [""] * n
     builder = _builder(batch)
     whole = batch.history_times is not None or batch.statistics or not set(batch.metrics) <= set(METRIC_UNITS)
     if whole:  # histories, statistics and the stress metrics need each case's whole result
@@ -309,7 +311,8 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
     while lo < n:
         built = builder.cases(batch.values[lo: lo + step])
         ok = [k for k, c in enumerate(built) if not isinstance(c, Exception)]
-        res = run_cases([built[k] for k in ok])
+        with WarningLog():  # each case's warnings are stored with it (res.warnings), not issued here
+            res = run_cases([built[k] for k in ok])
         row = {k: j for j, k in enumerate(ok)}
         for k, c in enumerate(built):
             err = c if isinstance(c, Exception) else res.errors[row[k]]
@@ -323,6 +326,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
                 out[m][lo + k] = res.scalars[j, col]
             status[lo + k] = res.status[j]
             out["modes"][lo + k] = res.modes[j]
+            out["warnings"][lo + k] = "\n".join(res.warnings[j])
             message[lo + k] = "" if res.status[j] == 0 else " ".join(str(res.messages[j]).split())
         if step == 1 and ok:  # then as many at once as the batch memory allows
             step = max(1, BATCH_BYTES // max(case_bytes(built[ok[0]]), 1))
@@ -343,16 +347,18 @@ def _run_one_by_one(batch: _Batch, base: Any, out: dict[str, Any], status: np.nd
     stats = _statistics_arrays(base, n) if batch.statistics else {}
     for k, vals in enumerate(batch.values):
         try:
-            sc = base.with_values(dict(zip(batch.paths, vals)))
-            res = simulate(sc)
-            metrics = res.metrics(impacts=False) if batch.metrics else {}
-            if stats:
-                from ..statistics.record import case_record
+            with WarningLog() as log:  # the case's warnings (the run's, its statistics'): stored with it
+                sc = base.with_values(dict(zip(batch.paths, vals)))
+                res = simulate(sc)
+                metrics = res.metrics(impacts=False) if batch.metrics else {}
+                if stats:
+                    from ..statistics.record import case_record
 
-                record = case_record(res)
-            if w is not None:  # NaN after this case's end_time
-                inside = ht <= sc.solver.end_time * (1.0 + 1e-12)
-                w[k][inside] = res.displacement(list(batch.history_points), ht[inside]).T
+                    record = case_record(res)
+                if w is not None:  # NaN after this case's end_time
+                    inside = ht <= sc.solver.end_time * (1.0 + 1e-12)
+                    w[k][inside] = res.displacement(list(batch.history_points), ht[inside]).T
+            out["warnings"][k] = "\n".join(log.messages)
         except Exception as exc:  # recorded: the sweep goes on
             if batch.on_error == "raise":
                 raise

@@ -142,8 +142,9 @@ class _Writer:
         self.group = zarr.open_group(store, mode="r+")
         names = (*spec.metrics, *statistic_names(spec), "message", "status")
         self.arrays = {name: self.group[name] for name in names}
-        if "modes" in self.group:  # solver.modes = "auto" (a store made before it was recorded has none)
-            self.arrays["modes"] = self.group["modes"]
+        for name in ("modes", "warnings"):  # a store made before they were recorded has none
+            if name in self.group:
+                self.arrays[name] = self.group[name]
         if spec.histories is not None:
             self.arrays["w"] = self.group["w"]
         self._threads: Any = None
@@ -156,7 +157,7 @@ class _Writer:
             if name == "status":
                 continue
             value = res[name]
-            if name == "message":
+            if name in ("message", "warnings"):
                 value = np.array(value, dtype=np.dtypes.StringDType())
             jobs.append((arr, np.asarray(value).reshape(shape + np.shape(value)[1:])))
         if self._threads is None:

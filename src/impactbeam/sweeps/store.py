@@ -72,6 +72,9 @@ def _template(spec: SweepSpec, chunk: tuple[int, ...]) -> tuple[xr.Dataset, dict
     enc["status"] = {"chunks": chunk, "fill_value": NOT_RUN}
     data["message"] = xr.Variable(dims, da.full(shape, "", dtype=S, chunks=-1), {"long_name": "error or solver message"})
     enc["message"] = {"chunks": chunk}
+    data["warnings"] = xr.Variable(dims, da.full(shape, "", dtype=S, chunks=-1),
+                                   {"long_name": "the case's warnings, one per line (empty: none)"})
+    enc["warnings"] = {"chunks": chunk}
     if spec.base.solver.modes == "auto":  # the count each case chose (0: not run or failed)
         data["modes"] = xr.Variable(dims, da.full(shape, 0, dtype=np.int16, chunks=-1),
                                     {"long_name": 'modes per state chosen by solver.modes = "auto"'})
@@ -283,7 +286,7 @@ def open_result(spec: SweepSpec, store: Any, in_memory: bool) -> xr.Dataset:
 
     ds = xr.open_zarr(store, consolidated=False, chunks=None)
     order = [*spec.metrics, *statistic_names(spec), "status", *(["modes"] if "modes" in ds else []), "message",
-             *(["w"] if spec.histories is not None else [])]
+             *(["warnings"] if "warnings" in ds else []), *(["w"] if spec.histories is not None else [])]
     ds = ds[order]  # the store lists its arrays in no particular order
     return ds.load() if in_memory else ds
 
