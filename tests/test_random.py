@@ -9,6 +9,7 @@ linear run against ``int |H|^2 G df`` from the exact modes (random_cases.py).
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -122,6 +123,9 @@ def test_random_scenario_keys_and_drawn_seed(scenario_file):
     out = CliRunner().invoke(main, ["simulate", str(path), "--json"], catch_exceptions=False)
     assert out.exit_code == 0
     assert isinstance(json.loads(out.stdout)["seed"], int)  # the drawn seed is reported
+    out = CliRunner().invoke(main, ["simulate", str(path)], catch_exceptions=False)
+    drawn = re.search(r"(?m)^  seed +(\S+)$", out.stdout).group(1)
+    assert re.fullmatch(r"\d+", drawn), drawn  # every digit, so the run can be repeated (was "1.48518e+09")
 
 
 BAD = [

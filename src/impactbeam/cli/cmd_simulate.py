@@ -167,7 +167,8 @@ def _summary(sc: Any, metrics: Mapping[str, Any]) -> str:
         if key in shown or isinstance(value, (list, tuple, dict)):
             continue
         x = _number(value)
-        rows.append((key.replace("_", " "), "n/a" if x is None else f"{x:.6g}"))
+        whole = isinstance(value, int) and not isinstance(value, bool)  # a seed, a count: every digit
+        rows.append((key.replace("_", " "), "n/a" if x is None else str(int(value)) if whole else f"{x:.6g}"))
     width = max((len(r[0]) for r in rows), default=0)
     lines += [f"  {label.ljust(width)}  {text}" for label, text in rows]
     events = list(metrics.get("events") or [])

@@ -223,14 +223,17 @@ def estimate_by_reruns(metrics: Mapping[str, Any], rerun: Callable[..., Any], n_
     peak_changes : ndarray
     counts : tuple of int
     """
+    from .._warnings import WarningLog
+
     counts = coarser_counts(n_modes)
     coarse = []
     for i, c in enumerate(counts):
-        if progress is None:
-            res = rerun(c)
-        else:
-            res = rerun(c, report=lambda t, i=i: progress(i + t / end_time))
-        coarse.append(res.metrics())
+        with WarningLog():  # the coarser runs' warnings (their initial projection, ...) are not this run's
+            if progress is None:
+                res = rerun(c)
+            else:
+                res = rerun(c, report=lambda t, i=i: progress(i + t / end_time))
+            coarse.append(res.metrics())
     changes, peaks = estimate(metrics, coarse)
     return changes, peaks, counts
 
