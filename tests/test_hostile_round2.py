@@ -377,6 +377,10 @@ def test_stress_fields_in_every_result_file(tmp_path: Path) -> None:
         for j, x in enumerate(res.points):
             np.testing.assert_array_equal(table[f"sigma(x={x:.6g}) [Pa]"].to_numpy(), ds["bending_stress"].values[:, j])
             np.testing.assert_array_equal(table[f"M(x={x:.6g}) [N m]"].to_numpy(), ds["bending_moment"].values[:, j])
+    # the Parquet file carries the provenance of the netCDF one (version, scenario, metrics); it had none
+    attrs = pd.read_parquet(tmp_path / "r.parquet").attrs
+    for key in ("impactbeam_version", "scenario", "metrics", "Conventions", "solver_modes"):
+        assert attrs[key] == ds.attrs[key], key
     ds.close()
 
 

@@ -7,6 +7,8 @@ import math
 import warnings
 from pathlib import Path
 
+import tomllib
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -85,6 +87,10 @@ def test_dataset_and_plot(scenario_file, tmp_path):
         assert ds.sizes["sample"] == 8
         np.testing.assert_allclose(ds["value"].values, [1e-4, 2e-4, 3e-4], rtol=1e-12)
         assert ds["strobe"].attrs["units"] == "m"
+        # its provenance, as a simulation's file has (it had none): version, scenario, when and how
+        assert ds.attrs["impactbeam_version"] == ib.__version__ and ds.attrs["Conventions"] == "CF-1.10"
+        assert ib.parse_scenario(tomllib.loads(ds.attrs["scenario"])).contactors[0].position > 0
+        assert "impactbeam" in ds.attrs["history"] and "bifurcation" in ds.attrs["history"]
     assert png.stat().st_size > 1000
 
 

@@ -78,6 +78,16 @@ def _harmonic_scenario() -> ib.Scenario:
     })
 
 
+def test_a_mean_stress_beyond_the_ultimate_strength_is_warned():
+    # Goodman with ultimate_strength = 1 Pa: every tensile-mean cycle breaks the part at once, the damage is
+    # infinite, which JSON shows as null (it read as "not applicable") next to a life of 0, without a word
+    sc = _harmonic_scenario().with_values({"fatigue.mean_stress": "goodman", "fatigue.ultimate_strength": 1.0})
+    with pytest.warns(ib.ImpactBeamWarning, match=r"fatigue: at x = 0 m, \d+ cycle\(s\) have a mean stress at or "
+                      "above fatigue.ultimate_strength"):
+        fat = fatigue_statistics(ib.simulate(sc))
+    assert math.isinf(fat[0]["damage"]) and fat[0]["life"] == 0.0
+
+
 def test_harmonic_miner_damage_is_f_over_n():
     """No contact, the exact harmonic steady state: k cycles of amplitude S give D = k / N(S)."""
     from scipy.optimize import minimize_scalar

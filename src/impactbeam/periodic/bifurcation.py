@@ -76,6 +76,7 @@ class BifurcationDiagram:
     settle_periods: int = 100
     record_periods: int = 50
     warnings: list[str] = field(default_factory=list)
+    scenario: str = field(default="", repr=False)  # the base scenario, as TOML (the files' provenance)
 
     def to_dict(self) -> dict[str, Any]:
         """``{"parameter", "points": [...], "warnings"}`` (the ``--json`` output)."""
@@ -85,6 +86,8 @@ class BifurcationDiagram:
     def to_xarray(self) -> Any:
         """Dataset with dims (value, sample): strobe, strobe_velocity, strobe_time; period, extremes per value."""
         import xarray as xr
+
+        from ..result.dataset import provenance
 
         n, r = len(self.points), self.record_periods
         strobe = np.full((n, r), np.nan)
@@ -117,8 +120,11 @@ class BifurcationDiagram:
                 "direction": ("value", np.array([p.direction for p in self.points], dtype=str)),
                 "sample": ("sample", np.arange(r)),
             },
-            attrs={"parameter": self.parameter, "settle_periods": self.settle_periods,
-                   "record_periods": self.record_periods, "warnings": "\n".join(self.warnings)},
+            attrs={**provenance(f"impactbeam bifurcation diagram over {self.parameter}", "bifurcation",
+                                "strobe samples of exact piecewise modal runs, each value continued from the last"),
+                   "parameter": self.parameter, "settle_periods": self.settle_periods,
+                   "record_periods": self.record_periods, "warnings": "\n".join(self.warnings),
+                   "scenario": self.scenario},
         )
         return ds
 
@@ -310,7 +316,7 @@ def bifurcation(
     for w in warns:
         emit_user_level_warning(w)
     unit = _unit(_dimension(parameter, scenario))
-    return BifurcationDiagram(parameter, points, unit, settle, record, warns)
+    return BifurcationDiagram(parameter, points, unit, settle, record, warns, scenario.to_toml())
 
 
 def _same_basis(state: Any, scenario: Scenario) -> bool:

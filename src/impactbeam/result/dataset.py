@@ -8,12 +8,59 @@ import numpy as np
 
 from .._io import json_text
 
-__all__ = ["result_dataset"]
+__all__ = ["result_dataset", "result_attrs", "provenance"]
 
 _REFERENCE = (
     "W. Xu and E. K. Ervin, Parameters affecting the transient response of an impacting beam, "
     "Shock and Vibration 20 (2013)"
 )
+
+
+def provenance(title: str, command: str, source: str) -> dict[str, str]:
+    """The CF attributes every file of results carries: what made it, when, with which version.
+
+    Parameters
+    ----------
+    title : str
+    command : str
+        The command or function that made it (``"simulate"``, ``"bifurcation"``).
+    source : str
+        The method, after ``"impactbeam <version>: "``.
+    """
+    import datetime
+
+    from .. import __version__
+
+    return {
+        "Conventions": "CF-1.10",
+        "title": title,
+        "history": f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')}: "
+                   f"impactbeam {__version__} {command}",
+        "source": f"impactbeam {__version__}: {source}",
+        "references": _REFERENCE,
+        "impactbeam_version": __version__,
+    }
+
+
+def result_attrs(result: Any) -> dict[str, Any]:
+    """The attributes of a result's files (netCDF, Parquet): provenance, scenario, metrics, solver settings.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    """
+    return {
+        **provenance(f"impactbeam simulation: {result.scenario_name}", "simulate",
+                     "exact piecewise modal solution (closed form between exact events)"),
+        "status": result.status,
+        "message": result.message,
+        "warnings": "; ".join(result.warnings),
+        "n_modes": result.n_modes,
+        "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
+        "scenario": result.scenario.to_toml() if result.scenario is not None else "",
+        "metrics": json_text(result.metrics(), indent=2),
+        **{f"solver_{k}": v for k, v in result.options.items()},
+    }
 
 
 def result_dataset(result: Any) -> Any:
@@ -27,11 +74,7 @@ def result_dataset(result: Any) -> Any:
     -------
     xarray.Dataset
     """
-    import datetime
-
     import xarray as xr
-
-    from .. import __version__
 
     n_c = len(result.contactors)
     kind = np.array([1 if e.kind == "impact" else 0 for e in result.events], dtype=np.int8)
@@ -76,24 +119,7 @@ def result_dataset(result: Any) -> Any:
                      {"long_name": "mode number"}),
             "event": ("event", np.arange(len(result.events), dtype=np.int32), {"long_name": "event number"}),
         },
-        attrs={
-            "Conventions": "CF-1.10",
-            "title": f"impactbeam simulation: {result.scenario_name}",
-            "history": f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')}: "
-                       f"impactbeam {__version__} simulate",
-            "source": f"impactbeam {__version__}: exact piecewise modal solution (closed form between exact "
-                      "events)",
-            "references": _REFERENCE,
-            "impactbeam_version": __version__,
-            "status": result.status,
-            "message": result.message,
-            "warnings": "; ".join(result.warnings),
-            "n_modes": result.n_modes,
-            "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
-            "scenario": result.scenario.to_toml() if result.scenario is not None else "",
-            "metrics": json_text(result.metrics(), indent=2),
-            **{f"solver_{k}": v for k, v in result.options.items()},
-        },
+        attrs=result_attrs(result),
     )
     for name, arr in result.energy.items():
         ds[f"energy_{name}"] = ("time", arr, {"units": "J", "long_name": f"energy: {name.replace('_', ' ')}"})

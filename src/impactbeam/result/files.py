@@ -54,6 +54,9 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     with atomic_path(path) as tmp:
         if suffix == ".csv":
             table.to_csv(tmp, index=False)
-        else:
+        else:  # Parquet keeps the attributes (pandas' attrs in its metadata); a CSV file has no place for them
+            from .dataset import result_attrs
+
+            table.attrs = {k: v if isinstance(v, (str, int, float)) else str(v) for k, v in result_attrs(result).items()}
             table.to_parquet(tmp, index=False)
     return path

@@ -277,6 +277,15 @@ def fatigue_statistics(result: ResultLike, spec: FatigueSpec | None = None,
             if spec.mean_stress == "none":
                 break
         damage, cyc, face = best  # type: ignore[misc]
+        broken = int(np.count_nonzero(cyc["cycles_to_failure"] == 0.0))
+        if broken:
+            from .._warnings import emit_user_level_warning
+
+            emit_user_level_warning(
+                f"fatigue: at x = {x:.6g} m, {broken} cycle(s) have a mean stress at or above "
+                f"fatigue.ultimate_strength ({spec.ultimate_strength:g} Pa; Goodman): the damage is infinite and the "
+                "life 0 (null in JSON); check the strength and its unit"
+            )
         rate = damage / (hi - lo)
         out.append({
             "point": float(x), "damage": damage, "damage_rate": rate, "life": 1.0 / rate if rate > 0 else math.inf,
