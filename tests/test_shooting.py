@@ -423,7 +423,9 @@ def test_cli_bad_input_exits_2(tmp_path):
     path = tmp_path / "h.toml"
     path.write_text(_toml(_raw()))
     out = _cli(["periodic", str(path), "--multiple", "0"])
-    assert out.exit_code == 2 and "multiple" in out.stderr and "Traceback" not in out.output
+    assert out.exit_code == 2 and out.stderr.startswith("error: --multiple: ") and "Traceback" not in out.output
+    out = _cli(["periodic", str(path), "--max-iterations", "-1"])  # the option as typed, not the API's max_iterations
+    assert out.exit_code == 2 and out.stderr.startswith("error: --max-iterations: ")
     raw = _raw()
     raw["excitation"] = {"kind": "base_acceleration", "shape": "step", "amplitude": 1.0}
     path.write_text(_toml(raw))

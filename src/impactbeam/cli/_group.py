@@ -80,7 +80,7 @@ def handle_errors(fn: F) -> F:
             try:
                 out = fn(*args, **kwargs)
             except ParameterError as exc:
-                fail(str(exc), 2)
+                fail(_as_option(str(exc)), 2)
             except ImpactBeamError as exc:  # SimulationError, ModeSolveError, WriteError ...
                 fail(_named(exc), 1)
             except OSError as exc:  # a file or a port the command did not report itself
@@ -96,6 +96,18 @@ def handle_errors(fn: F) -> F:
         return out
 
     return wrapper  # type: ignore[return-value]
+
+
+def _as_option(message: str) -> str:
+    """A message about an API argument (``multiple: ...``) named by the command's option (``--multiple: ...``)."""
+    ctx = click.get_current_context(silent=True)
+    name, sep, rest = message.partition(": ")
+    if ctx is None or not sep:
+        return message
+    for param in ctx.command.params:
+        if isinstance(param, click.Option) and param.name == name:
+            return f"{max(param.opts, key=len)}: {rest}"
+    return message
 
 
 def _option_of(path: str) -> str | None:

@@ -59,7 +59,11 @@ def convergence(scenario: str, modes: str | None, max_modes: int, as_json: bool,
 
     with progress_bar(1.0, desc="convergence", unit="", bar_format="{desc}: {percentage:3.0f}%|{bar}| "
                       "[{elapsed}<{remaining}]") as report:
-        study = convergence_study(sc, counts, max_modes=max_modes, progress=report)
+        try:
+            study = convergence_study(sc, counts, max_modes=max_modes, progress=report)
+        except ParameterError as exc:  # the API's argument "counts" is this command's --modes
+            text = str(exc)
+            raise ParameterError("--modes: " + text[len("counts: "):] if text.startswith("counts: ") else text) from None
     if plot is not None:
         _figure(study, plot)
     caught = take_warnings()

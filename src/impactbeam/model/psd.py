@@ -101,7 +101,7 @@ class PowerSpectralDensity:
         for i, (fi, gi) in enumerate(zip(f, g)):
             positive_finite(f"{key}.{i}.0", fi)
             if not (math.isfinite(gi) and gi >= 0.0):
-                raise ParameterError(f"{key}.{i}.1: the level must be zero or positive and finite, got {gi!r}")
+                raise ParameterError(f"{key}.{i}.1: the level must be zero or positive and finite, got {float(gi):g}")
             if i and fi <= f[i - 1]:
                 raise ParameterError(
                     f"{key}.{i}.0: frequencies must increase strictly, got {fi:g} Hz after {f[i - 1]:g} Hz"
