@@ -27,8 +27,8 @@ Everything the package writes or reads as a file goes through here:
   the same layout: cells separated by commas, or semicolons, or tabs (the
   first of these that occurs), else by blanks; blank lines and lines starting
   with ``#`` skipped; an optional header line naming the columns, each with an
-  optional unit in brackets or parentheses (``time [ms],acceleration [g]`` or
-  ``time (ms),acceleration (g)``); a column without a unit is SI. The caller
+  optional unit in brackets or parentheses at its end (``time [ms]``, ``acc
+  (mm/(s^2))``); a column without a unit is SI. The caller
   decides what a unit means for each column and passes the SI factors to
   :func:`numeric_columns`, which scales each written number in decimal
   arithmetic (:func:`impactbeam.units.scale_decimal`), so ``1.5`` in a
@@ -60,7 +60,7 @@ __all__ = [
     "to_jsonable", "json_text", "RESULT_SUFFIXES", "PLOT_SUFFIXES", "check_output", "check_writable",
     "WriteError", "write_error", "atomic_path", "write_text", "write_bytes", "write_netcdf", "pid_alive",
     "read_text_file", "TEXT_MEMORY_FACTOR",
-    "HEADER_CELL", "header_cell", "DelimitedText", "numeric_columns", "read_data_lines", "read_delimited",
+    "HEADER_CELL", "DelimitedText", "numeric_columns", "read_data_lines", "read_delimited",
 ]
 
 # --------------------------------------------------------------------------- JSON
@@ -314,29 +314,15 @@ def write_netcdf(dataset: Any, path: str | os.PathLike[str]) -> None:
 
 # --------------------------------------------------------------------------- delimited text
 
-# a unit in brackets (parentheses allowed inside: "[mm/(s^2)]") or in parentheses (one level inside: "(mm/(s^2))")
-_UNIT_GROUP = r"(?:\[[^\[\]]*\]|\((?:[^()]|\([^()]*\))*\))"
+_UNIT_GROUP = r"(?:\[[^\[\]]*\]|\((?:[^()]|\([^()]*\))*\))"  # [mm/(s^2)] or (mm/(s^2)): one level inside
 #: A header cell: a name and an optional unit in brackets or parentheses, at its end.
 HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?P<group>" + _UNIT_GROUP + r")?\s*$")
-
 _BLANK_HEADER = re.compile(r"[^\s\[\]()]+(?:\s*" + _UNIT_GROUP + r")?|" + _UNIT_GROUP)
 
 
-def header_cell(cell: str) -> tuple[str, str | None]:
-    """The name and the unit (None when none is given) of a header cell such as ``acc [mm/(s^2)]``.
-
-    Parameters
-    ----------
-    cell : str
-        The cell's text.
-
-    Returns
-    -------
-    (name, unit)
-        ``unit`` is None for a cell without one; a cell whose unit cannot be
-        told (a bracket left open, ``time/ms``) raises ValueError instead of
-        passing for a name, which would read its column as SI.
-    """
+def _header_cell(cell: str) -> tuple[str, str | None]:
+    """Name and unit (None: none given) of a header cell; ValueError when its unit cannot be told (``time/ms``,
+    a bracket left open), which would otherwise pass for a name and its column be read as SI."""
     m = HEADER_CELL.match(cell)
     name = (m.group("name") if m else cell).strip()
     group = m.group("group") if m else None
@@ -546,14 +532,10 @@ def read_delimited(
         )
     header = not any(_is_number(c) for c in first)
     if header:
-        names, units = [], []
-        for cell in first:
-            try:
-                name, unit = header_cell(cell)
-            except ValueError as exc:
-                raise fail(f"line {n0}: {exc}") from None
-            names.append(name)
-            units.append(unit)
+        try:
+            names, units = (list(col) for col in zip(*(_header_cell(cell) for cell in first)))
+        except ValueError as exc:
+            raise fail(f"line {n0}: {exc}") from None
         rows = lines[1:]
     else:
         names = ["time"] + [f"column {j}" for j in range(2, len(first) + 1)]

@@ -68,6 +68,8 @@ class BifurcationDiagram:
         SI unit of the parameter ("" when dimensionless or unknown).
     settle_periods, record_periods : int
     warnings : list of str
+    scenario : str
+        The base scenario as TOML (the files' provenance).
     """
 
     parameter: str
