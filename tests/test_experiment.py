@@ -229,6 +229,24 @@ def test_compare_identity(case3_truth):
     plt.close(fig)
 
 
+def test_compare_a_window_and_a_point_off_the_contactor(case3_truth):
+    """The truth's own samples from 50 ms on: the simulated features were taken from t = 0 (the first major
+    peak 45 % off, its time 80 %) while the measured ones came from the window; at the tip the contact
+    duration was the time the tip's deflection spent beyond the contactor's gap (5.17 ms for 4.02 ms)."""
+    sc, res = case3_truth
+    t = np.arange(100, 400) / FS
+    x = sc.contactors[0].position
+    cmp = ex.compare(sc, ex.Record(t, res.displacement([x], t)[0]))
+    for key in ("first_peak", "first_negative_peak"):  # sampling at 2 kHz: 1 % (test above)
+        assert cmp.features[key]["measured"] == pytest.approx(cmp.features[key]["simulated"], rel=0.01)
+    for key in ("first_peak_time", "first_negative_peak_time", "first_contact_duration"):
+        assert abs(cmp.features[key]["measured"] - cmp.features[key]["simulated"]) < 1e-4
+    tip = sc.beam.length
+    cmp = ex.compare(sc, ex.Record(t, res.displacement([tip], t)[0]), point=tip)
+    assert cmp.features["first_contact_duration"] == {"simulated": None, "measured": None, "difference_percent": None}
+    assert cmp.features["first_peak"]["simulated"] is not None
+
+
 def test_compare_finds_amplitude_error(case3_truth):
     """A model whose pulse is 10 % weaker under-predicts the first peak by about
     10 % (linear before the first impact): -12 % < difference < -7 %."""

@@ -5,6 +5,7 @@ section-4 quantities side by side, and their overlay plot.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -396,9 +397,12 @@ def compare(
     w_sim = result.displacement([x], meas.time)[0]
     sim_rec = Record(meas.time, w_sim, name="simulated deflection", quantity="deflection")
     sign = response_point(sc.contactors, sc.output_points)[1]
-    gap = sc.contactors[0].gap if sc.contactors else None
+    # contact is told from the deflection at the contactor: elsewhere the contact features are undefined
+    at_stop = bool(sc.contactors) and math.isclose(x, sc.contactors[0].position, rel_tol=0.0,
+                                                   abs_tol=1e-9 * sc.beam.length)
+    gap = sc.contactors[0].gap if at_stop else None
     fm = response_features(meas.time, sign * meas.values, gap=gap)
-    tg = scan_times(result, 0.0, float(result.solution.t_end), breaks=False)
+    tg = scan_times(result, float(meas.time[0]), float(meas.time[-1]), breaks=False)  # the span of the record
     fs = response_features(tg, sign * result.displacement([x], tg)[0], gap=gap)
     feats: dict[str, dict[str, float | None]] = {}
     for k in FEATURES:

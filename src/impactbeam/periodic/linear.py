@@ -158,8 +158,9 @@ def linear_limit(scenario: Scenario, start: ModalState | None) -> ModalState | N
     steady = _steady_state(pk, opt, scenario, q)
     if start is not None and start.basis != steady.basis:
         return None
-    a = np.zeros_like(om) if start is None else start.eta - steady.eta
-    b = np.zeros_like(om) if start is None else start.deta - steady.deta
+    # the transient: the start's departure from the steady state (from rest, minus the steady state itself)
+    a = (np.zeros_like(om) if start is None else start.eta) - steady.eta
+    b = (np.zeros_like(om) if start is None else start.deta) - steady.deta
     R = np.hypot(a, (b + dec * a) / wd)
     Wc = pk.Wc[0]  # (n_contactors, n_modes)
     reach = np.abs(Wc @ q) + np.abs(Wc) @ R

@@ -178,19 +178,37 @@ def _lag_pairs(n_samples: int, top: int) -> tuple[np.ndarray, np.ndarray, np.nda
     return first, second, starts
 
 
+#: A period above 1 whose shorter-lag mismatches shrink by more than this fraction from the first to the
+#: last whole repetitions of the record is a transient decaying onto a shorter period (:func:`still_settling`).
+DECAY = 0.05
+
+
 def still_settling(samples: np.ndarray, period: int, tolerance: float) -> bool:
     """Whether a shorter period than ``period`` (or 1 when none) is being approached.
 
-    True when for some ``m`` below ``period`` (all ``m`` up to a quarter of
-    the record when ``period`` is 0) the mismatch ``|s_{k+m} - s_k|`` over the
-    second half of the record is less than half of that over the first half
-    and still above ``tolerance``: a decaying transient, which aliased by the
-    strobe can pass for a longer period.
+    For each ``m`` below ``period`` (all ``m`` up to a quarter of the record
+    when ``period`` is 0) the mismatch ``d_k = |s_{k+m} - s_k|`` is compared
+    between the first and the second half of the record. A period ``n > 1``
+    repeats ``d_k`` every ``n`` samples, so its means over whole repetitions
+    in the two halves are equal; a transient decaying onto a shorter period,
+    which the strobe aliases into a longer one (a multiplier ``mu`` near a
+    root of unity, ``|mu|`` near 1: ``mu^n`` is near 1 before the transient
+    has decayed), shrinks them. True when the second half's mean is below
+    ``1 - DECAY`` of the first's, that still above ``tolerance`` (without a
+    period: the second half's largest below half the first's).
     """
     s = np.asarray(samples, dtype=float)
     top = period - 1 if period else max(1, (s.shape[0] - 1) // 4)
     for m in range(1, top + 1):
         d = np.max(np.abs(s[m:] - s[:-m]), axis=1)
+        if period:  # whole repetitions of the period in each half
+            h = (d.size // 2) // period * period
+            if h < period:
+                break
+            early, late = float(np.mean(d[:h])), float(np.mean(d[d.size - h:]))
+            if early > tolerance and late < (1.0 - DECAY) * early:
+                return True
+            continue
         h = d.size // 2
         if h < 2:
             break
