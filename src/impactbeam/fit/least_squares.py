@@ -115,7 +115,7 @@ def fit(
 
     paths, user_bounds = _checked_params(params, bounds, max_nfev, scenario.excitation.kind)
     base, meas = prepare_run(scenario, measured, None, hold, window)
-    override, trace = _excitation_override(base, excitation, hold)
+    override = _excitation_override(base, excitation, hold)
     # base.data drives with_values: keep the end time there too
     base = base.with_values({"solver.end_time": float(meas.time[-1])})
     x = record_point(base, point)
@@ -181,8 +181,8 @@ def fit(
         measured=meas,
         point=x,
         residual=np.asarray(final),
-        _trace=trace,
         _data=data,
+        _override=override is not None,
     )
 
 
@@ -206,21 +206,19 @@ def _checked_params(
     return paths, user_bounds
 
 
-def _excitation_override(
-    base: Scenario, excitation: Record | Excitation | None, hold: str
-) -> tuple[Excitation | None, tuple[Record, str] | None]:
-    """The excitation replacing the scenario's, and the measured trace behind it if any."""
+def _excitation_override(base: Scenario, excitation: Record | Excitation | None, hold: str) -> Excitation | None:
+    """The excitation replacing the scenario's (a measured trace made into a table), if any."""
     from ..model.loading import Excitation
 
     if isinstance(excitation, Record):
         from ..experiment import drive_with_trace
 
-        return drive_with_trace(base, excitation, hold=hold).excitation, (excitation, hold)
+        return drive_with_trace(base, excitation, hold=hold).excitation
     if isinstance(excitation, Excitation):
-        return excitation, None
+        return excitation
     if excitation is not None:
         raise ParameterError(f"excitation: expected a Record or an Excitation, got {type(excitation).__name__}")
-    return None, None
+    return None
 
 
 def _with_fitted(base: Scenario, override: Excitation | None, values: Mapping[str, float]) -> Scenario:

@@ -78,8 +78,8 @@ class FitResult:
     measured: Record | None = field(default=None, repr=False)
     point: float = math.nan
     residual: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    _trace: tuple[Record, str] | None = field(default=None, repr=False)
     _data: dict[str, Any] = field(default_factory=dict, repr=False)
+    _override: bool = field(default=False, repr=False)  # the excitation replaced the scenario's (a trace or an object)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-Python summary (for JSON)."""
@@ -147,9 +147,9 @@ class FitResult:
         Parameters
         ----------
         out : str or path-like, optional
-            Where the scenario will be written: with a measured trace the
-            excitation then refers to ``<out stem>_excitation.csv`` (see
-            :meth:`write_scenario`).
+            Where the scenario will be written: with a measured trace (or any
+            sampled excitation) the excitation then refers to ``<out
+            stem>_excitation.csv`` (see :meth:`write_scenario`).
 
         Returns
         -------
@@ -158,14 +158,9 @@ class FitResult:
         from ..scenario import set_path
 
         data = self._data
-        if self._trace is not None:
+        if self._override:  # the fitted excitation (its start, scale ...), not the scenario's
             name = f"{Path(out).stem}_excitation.csv" if out is not None else "excitation.csv"
-            trace, hold = self._trace
-            ex = {"kind": "base_acceleration", "shape": "table", "file": name, "hold": hold}
-            scale = self.scenario.excitation.scale
-            if scale != 1.0:
-                ex["scale"] = scale
-            data = set_path(data, "excitation", ex)
+            data = set_path(data, "excitation", excitation_data(self.scenario.excitation, name))
         return data
 
     def write_scenario(self, path: str | Path) -> list[Path]:
@@ -190,11 +185,12 @@ class FitResult:
         if not target.parent.is_dir():
             raise ParameterError(f'--out: directory "{target.parent}" does not exist')
         written = []
-        if self._trace is not None:
-            trace, _ = self._trace
+        ex = self.scenario.excitation
+        if self._override and ex.times is not None:  # the samples of the fitted excitation
             csv_path = target.with_name(f"{target.stem}_excitation.csv")
-            lines = ["# base acceleration trace used by the fit (impactbeam fit)", "time [s],base_acceleration [m/s^2]"]
-            lines += [f"{t!r},{v!r}" for t, v in zip(trace.time.tolist(), trace.values.tolist())]
+            unit = {"base_acceleration": "m/s^2", "point_force": "N", "distributed_force": "N/m"}[ex.kind]
+            lines = ["# excitation used by the fit (impactbeam fit)", f"time [s],{ex.kind} [{unit}]"]
+            lines += [f"{t!r},{v!r}" for t, v in zip(ex.times.tolist(), ex.values.tolist())]
             write_text(csv_path, "\n".join(lines) + "\n")
             written.append(csv_path)
         data = self.scenario_data(target)
@@ -206,3 +202,29 @@ class FitResult:
         dump_scenario(data, target)
         written.append(target)
         return written
+
+
+def excitation_data(ex: Any, file: str) -> dict[str, Any]:
+    """An excitation object as a scenario's ``[excitation]`` table (SI numbers); a sampled one refers to ``file``.
+
+    Parameters
+    ----------
+    ex : Excitation
+    file : str
+        The file its samples are written to (a table or a random load).
+    """
+    sampled = ex.shape in ("table", "random")
+    raw: dict[str, Any] = {"kind": ex.kind, "shape": "table" if sampled else ex.shape}
+    if ex.kind == "point_force":
+        raw["position"] = ex.position
+    keys = {"half_sine": ("amplitude", "duration"), "step": ("amplitude",),
+            "harmonic": ("amplitude", "frequency", "phase")}.get(ex.shape, ())
+    raw.update({k: float(getattr(ex, k)) for k in keys})
+    if sampled:
+        raw.update(file=file, hold="linear" if ex.shape == "random" else ex.hold)
+    if ex.start:
+        raw["start"] = float(ex.start)
+    if ex.scale != 1.0:
+        raw["scale"] = float(ex.scale)
+    return raw
+
