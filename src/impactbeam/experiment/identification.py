@@ -251,15 +251,19 @@ def identify(
     if scenario is not None:
         from ..modal import mode_set
 
-        xi1 = damping[0].fit if math.isfinite(damping[0].fit) and 0 <= damping[0].fit < 1 else 0.0
-        f1n = freqs[0] / math.sqrt(1.0 - xi1**2)  # the spectral peak is the damped frequency
+        d0 = damping[0]  # the spectral peak is the damped frequency; corrected by a damping the fit resolves
+        sure = math.isfinite(d0.fit) and 0 <= d0.fit < 1 and d0.fit_standard_error < 0.5 * d0.fit
+        xi1 = d0.fit if sure else 0.0
+        f1n = freqs[0] / math.sqrt(1.0 - xi1**2)
         ms0 = mode_set(scenario.beam, (), scenario.solver.modes)
-        e_new = modulus_from_frequency(scenario, f1n)
+        mode = _model_mode(record, f1n, ms0.frequencies_hz[ms0.n_rigid:])
+        e_new = modulus_from_frequency(scenario, f1n, mode=mode)
         updates["beam.youngs_modulus"] = e_new
         sc_e = scenario.with_values({"beam.youngs_modulus": e_new})
         ms1 = mode_set(sc_e.beam, (), scenario.solver.modes)
         model.update({
             "natural_frequency_hz": f1n,
+            "mode": mode,
             "model_frequencies_hz": [float(f) for f in ms0.frequencies_hz[ms0.n_rigid : ms0.n_rigid + count]],
             "scenario_youngs_modulus": scenario.beam.youngs_modulus,
             "youngs_modulus": e_new,
@@ -286,3 +290,32 @@ def identify(
                 "contact_stiffness": k,
             })
     return Identification(record=record, frequencies=fe, damping=damping, model=model, updates=updates)
+
+
+def _model_mode(record: Record, f: float, model_hz: np.ndarray) -> int:
+    """The model's elastic mode (1, 2, ...) nearest ``f`` in ratio, warned when it is not the first.
+
+    The record's lowest identified frequency is taken for the first mode; on a
+    record of few cycles of it (or with it weakly excited) the strongest peak
+    can be the second, and the modulus from it read as the first's would be
+    off by the square of their ratio (x88 on a 0.05 s free decay of the
+    specimen). A record sampled below twice the model's first frequency
+    shows aliases: warned too.
+    """
+    dt = float(np.median(np.diff(record.time)))
+    if model_hz.size and 0.5 / dt < model_hz[0]:
+        emit_user_level_warning(
+            f"{record.label}: sampled at {1 / dt:.4g} Hz, below twice the model's first frequency "
+            f"({model_hz[0]:.4g} Hz): the identified frequencies may be aliases"
+        )
+    if not model_hz.size:
+        return 1
+    mode = int(np.argmin(np.abs(np.log(model_hz / f)))) + 1
+    if mode != 1:
+        emit_user_level_warning(
+            f"{record.label}: the lowest identified frequency, {f:.5g} Hz, is nearest the model's mode {mode} "
+            f"({model_hz[mode - 1]:.5g} Hz), not its first ({model_hz[0]:.5g} Hz): the modulus is taken from "
+            f"mode {mode}; a longer record or a larger count finds the first"
+        )
+    return mode
+
