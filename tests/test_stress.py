@@ -167,3 +167,18 @@ def test_output_fields_by_any_of_their_names():
         sc.with_values({"output.fields": ["strain"]})
     with pytest.raises(ScenarioError, match="output.fields.1"):
         sc.with_values({"output.fields": ["moment", "bending_moment"]})
+
+
+def test_the_static_correction_uses_the_runs_own_load():
+    """Runs that differ only in their load's time history share one packed problem (its states, built with
+    the first run's load); the stress's static correction read the load from it, so a 5 N pulse after a 1 N one
+    had the 1 N pulse in its correction (max stress 3.4 % high, 19 % at one point and time). Without contact
+    the beam is linear: the 5 N stress is 5 times the 1 N stress (round-off: 1e-12), whichever ran first."""
+    beam = ib.Beam.rectangular(0.1, 0.01, 0.003, 2e9, 1000.0)
+    opts = ib.SolverOptions(modes=3, end_time=0.02, time_step=1e-4)
+    pulse = {a: ib.Excitation(kind="point_force", shape="half_sine", amplitude=a, duration=2e-3, position=0.1)
+             for a in (1.0, 5.0)}
+    x, t = [0.0, 0.03, 0.07], np.linspace(0.0, 0.02, 41)
+    one = ib.simulate_system(beam, excitation=pulse[1.0], options=opts).bending_stress(x, t)
+    five = ib.simulate_system(beam, excitation=pulse[5.0], options=opts).bending_stress(x, t)
+    np.testing.assert_allclose(five, 5.0 * one, rtol=0, atol=1e-12 * np.abs(five).max())

@@ -469,7 +469,7 @@ class SimulationResult:
         if not hasattr(self.solution, "modal_state"):
             raise ParameterError('final_state: only a run with method = "exact" has a modal state to continue from')
         basis = basis_signature(self.beam, self.contactors, self.n_modes, self.options.get("basis", "enriched"),
-                                self.solution.packed.space.excitation)
+                                self.solution.excitation)
         return self.solution.modal_state(self.solution.t_end, basis)
 
     # ------------------------------------------------------------------ derived

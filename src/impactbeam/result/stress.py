@@ -131,7 +131,7 @@ def _static_part(result: Any, space: Any, free: Any, x: np.ndarray, t: np.ndarra
                  rows: np.ndarray) -> np.ndarray:
     """``M_st - sum_j Q_j / lambda_j EI psi_j''`` of the mode-acceleration method: (n_t, n_x)."""
     beam = result.beam
-    excitation = space.excitation
+    excitation = result.solution.excitation  # this run's (the packed problem's may be another run's)
     u = np.asarray(excitation.history(t), dtype=float) if excitation.kind != "none" else np.zeros(t.size)
     Q = u[:, None] * np.asarray(free.load_weights, dtype=float)[None, :]
     out = u[:, None] * _excitation_static(beam, excitation, x)[None, :]
@@ -202,7 +202,7 @@ def max_bending_stress(result: ResultLike, *, points: int = 201) -> tuple[float,
     L, t_end = beam.length, sol.t_end
     t = scan_times(result, 0.0, t_end)
     extra = [c.position for c in result.contactors]
-    excitation = sol.packed.space.excitation
+    excitation = sol.excitation
     if excitation.kind == "point_force":
         extra.append(float(excitation.position))
     x = np.unique(np.concatenate([np.linspace(0.0, L, points), extra]))

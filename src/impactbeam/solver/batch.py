@@ -210,7 +210,7 @@ def integrate_batch(
             j = k - 1
             con = (gaps[j].copy(), sides[j].copy(), kst)
             sol = _solution(pk, tuple(contactor_sets[j]), options[j], pieces[j], con, fc, ic, rec,
-                            _loop.CHATTER if status[j] == 1 else _loop.DONE)
+                            _loop.CHATTER if status[j] == 1 else _loop.DONE, excitations[j])
             nxt = case_done(j, sol)  # type: ignore[misc]
             if nxt is not None and k < n:
                 eta0[k] = nxt[0]

@@ -395,10 +395,10 @@ def integrate(
     carry = (eta, deta, eta.copy(), deta.copy(), np.zeros(nc1, dtype=np.int64), np.zeros(nc1, dtype=np.int64),
              np.zeros(3 * max(2 * len(contactors), 1)))
     with _records(nm, int(pcs[0].size)) as rec:
-        return _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress)
+        return _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress, excitation)
 
 
-def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress) -> Solution:
+def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, progress, excitation) -> Solution:
     """The loop of :func:`integrate` with the arrays it supplies; the solution copied out of ``rec``."""
     while True:
         ic[_loop.I_NSLOTS] = pk.nslots
@@ -419,11 +419,14 @@ def _run_loop(K, pk, contactors, options, pcs, con, tol_h, fc, ic, carry, rec, p
             break
     if progress is not None:
         progress(float(fc[_loop.F_T]))
-    return _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take=True)
+    return _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, excitation, take=True)
 
 
-def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take: bool = False) -> Solution:
-    """The solution in ``rec``: copied, or with ``take`` (records no later run writes) its large arrays taken."""
+def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, excitation, take: bool = False) -> Solution:
+    """The solution in ``rec``: copied, or with ``take`` (records no later run writes) its large arrays taken.
+
+    ``excitation`` is the run's own load (the packed problem, shared by runs that differ in their loads' time
+    histories, holds the one it was built with)."""
     nseg, nev, njump = int(ic[_loop.I_NSEG]), int(ic[_loop.I_NEV]), int(ic[_loop.I_NJUMP])
     t_stop = float(fc[_loop.F_T])
     code = 1 if status == _loop.CHATTER else 0
@@ -445,7 +448,7 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, take: bool
         energy_jumps=rec.jumps[:njump].copy(), event_penetrations=rec.ev_d[:nev].copy(), status=code,
         message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
-        n_modes=pk.n_modes, event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy(),
+        n_modes=pk.n_modes, excitation=excitation, event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy(),
                                           rec.ev_v[:nev].copy()),
     )
 

@@ -69,6 +69,7 @@ class IvpSolution(PiecewiseSolution):
     def __init__(self, ref: Any, segments, events, jumps, status, message, t_end, penetrations,
                  moved: tuple | None = None, energy: tuple | None = None) -> None:
         self.ref = ref
+        self.excitation = ref.excitation  # the run's load
         self.segments = segments
         self.events = events
         self.energy_jumps = jumps

@@ -316,11 +316,14 @@ class Solution(PiecewiseSolution):
     event_arrays : tuple of ndarray, optional
         The events as arrays: times [s], kinds (1 impact, 0 rebound),
         contactors and velocities [m/s] (default: from ``events``).
+    excitation : Excitation, optional
+        The run's load (default: the packed problem's, which runs that differ
+        only in their loads' time histories share).
     """
 
     def __init__(self, *, t0, t1, slot, piece, eta0, deta0, packed, pieces, contactor_arrays, contactors,
                  events, energy_jumps, event_penetrations, status, message, warnings, t_end, evaluations,
-                 n_modes, event_arrays=None) -> None:
+                 n_modes, event_arrays=None, excitation=None) -> None:
         self.t0 = t0
         self.t1 = t1
         self.slot = slot
@@ -340,6 +343,7 @@ class Solution(PiecewiseSolution):
         self.t_end = t_end
         self.evaluations = evaluations
         self.n_modes = n_modes
+        self.excitation = packed.space.excitation if excitation is None else excitation
         self.dashpots = packed.dash
         self._atol = TOUCH * float(packed.space.beam.length)
         self._rows: dict[bytes, np.ndarray] = {}  # mode shapes at a few positions (metrics, dense queries)

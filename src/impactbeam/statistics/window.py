@@ -34,11 +34,9 @@ SETTLE_DECADES = 3.0
 
 
 def _excitation(result: ResultLike) -> Any:
-    sol = result.solution
-    space = getattr(getattr(sol, "packed", None), "space", None)
-    if space is not None:
-        return space.excitation
-    return getattr(getattr(result, "scenario", None), "excitation", None)
+    """The run's load: the solution's own (the packed problem's may be another run's of the same structure)."""
+    own = getattr(result.solution, "excitation", None)
+    return own if own is not None else getattr(getattr(result, "scenario", None), "excitation", None)
 
 
 def settling_time(result: ResultLike) -> float:
