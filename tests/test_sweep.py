@@ -171,6 +171,24 @@ metrics = ["n_impacts"]
     assert out.returncode == 0 and "1 with warnings (see the warnings variable)" in out.stderr, out.stderr
 
 
+def test_a_swept_start_redraws_a_random_record(tmp_path):
+    """A random load's record lasts end_time - start, drawn when the scenario is read; a swept start moved the
+    start-0 record instead (at start 0.1 s: 15 impacts stored where the scenario alone has 20)."""
+    base = CASE3.read_text().split("[excitation]")[0] + (
+        '[excitation]\nkind = "base_acceleration"\nshape = "random"\n'
+        'psd = [["10 Hz", "0.01 g^2/Hz"], ["500 Hz", "0.01 g^2/Hz"]]\nseed = 7\n'
+        "[solver]\nmodes = 4\ntime_step = 1e-4\nend_time = 0.3\n")
+    base = base.replace('gap = "0.229 mm"', 'gap = "0.05 mm"')
+    _write(tmp_path, "rand.toml", base)
+    text = 'base = "rand.toml"\n[parameters."excitation.start"]\nvalues = [0.0, 0.1]\n' \
+           '[outputs]\nmetrics = ["max_response", "n_impacts"]\n'
+    ds = run_sweep(_write(tmp_path, "s.toml", text), None, workers=0, progress=False).dataset
+    for start in (0.0, 0.1):
+        alone = ib.simulate(ib.load_scenario(tmp_path / "rand.toml").with_values({"excitation.start": start})).metrics()
+        case = ds.sel({"excitation.start": start})
+        assert int(case["n_impacts"]) == alone["n_impacts"] and float(case["max_response"]) == alone["max_response"]
+
+
 def test_failed_case_is_recorded_and_the_sweep_goes_on(tmp_path):
     """A contactor at 0.06 m lies off a 0.05 m beam: only that combination fails."""
     text = f"""

@@ -231,8 +231,10 @@ class _CaseBuilder:
 
     def _record_depends(self, group: Any) -> bool:
         """Whether a direct value also changes what the parser derives from it: a random load's record lasts
-        ``solver.end_time`` and is drawn when the scenario is read, so those cases are read whole."""
-        return group.excitation.shape == "random" and any(self.paths[i] == "solver.end_time" for i in self.direct)
+        ``solver.end_time - excitation.start`` and is drawn when the scenario is read, so those cases are read
+        whole (a swept start had moved the start-0 record instead)."""
+        derived = ("solver.end_time", "excitation.start")
+        return group.excitation.shape == "random" and any(self.paths[i] in derived for i in self.direct)
 
     def _made(self, section: str, gkey: str, changes: list[tuple[Any, ...]], group: Any) -> Any:
         """The group's contactors, excitation or solver options with ``changes`` made (one object per change set)."""
