@@ -123,6 +123,26 @@ def test_a_contact_under_way_at_the_start_is_no_energy_change(method):
     assert res.warnings == ()
 
 
+@pytest.mark.parametrize("method", ["exact", "ivp"])
+@pytest.mark.parametrize("law", [{"damping": 0.137}, {"restitution": 0.5}])
+def test_a_dashpot_stop_engaged_at_the_start_books_no_release(method, law):
+    """A cantilever resting on a dashpot stop (k = 412 N/m) under a tip preload, nothing else acting: nothing
+    moves and nothing is dissipated. The engagement at t = 0 was booked as a dashpot's re-engagement: the
+    dashpots' work -k d0^2/2 (-2.9e-4 J, negative dissipation) and the ledger's residual +k d0^2/2 for the
+    whole run. Measured now: 1e-33 J and 4e-17 J; tolerance 1e-12 of the spring's energy (round-off)."""
+    L = 0.1092
+    sc = ib.parse_scenario({
+        "beam": {"length": L, "width": 0.00993, "height": 0.00303, "youngs_modulus": 1834e6, "density": 951.98},
+        "contactors": [{"position": 0.07, "stiffness": 412.0, "gap": 0.0, "side": "below", **law}],
+        "damping": {"free": 0.0, "contact": 0.0}, "preload": {"kind": "point_force", "amplitude": -0.5, "position": L},
+        "initial": {"equilibrium": True}, "solver": {"modes": 6, "end_time": 0.05}})
+    res = ib.simulate(sc, method=method)
+    spring = float(res.energy["contactor"][0])
+    assert spring > 1e-4
+    assert abs(res.energy["dashpots"][-1]) <= 1e-12 * spring and abs(res.energy["residual"][-1]) <= 1e-12 * spring
+    assert abs(res.metrics(impacts=False)["energy_residual"]) <= 1e-12 * spring
+
+
 def _pinned_on_a_stiff_stop(basis: str, modes: int) -> ib.Scenario:
     return ib.parse_scenario({
         "beam": {"length": 1.0, "width": 0.02, "height": 0.01, "youngs_modulus": 2e11, "density": 7800.0},

@@ -565,3 +565,21 @@ def test_one_writer_per_store(tmp_path):
     lock.write_text(_json.dumps({"pid": 2**22 + 12345, "host": socket.gethostname(), "started": 0}))
     run = run_sweep(path, out, workers=0, progress=False)
     assert run.computed == 12 and not lock.exists()
+
+
+def test_a_changed_trace_file_is_another_sweep(tmp_path):
+    """The hash covered the base scenario's data, which names the trace file but holds none of its numbers: a
+    store made with one trace was resumed ("0 computed, 4 already done") after the trace changed."""
+    from impactbeam.exceptions import ParameterError
+
+    (tmp_path / "pulse.csv").write_text("t,a\n0,0\n0.005,100\n0.01,0\n")
+    base = CASE3.read_text().split("[excitation]")[0] + (
+        '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "pulse.csv"\n'
+        "[solver]\nmodes = 4\nend_time = 0.02\n")
+    _write(tmp_path, "b.toml", base)
+    path = _write(tmp_path, "s.toml", 'base = "b.toml"\n[parameters."excitation.scale"]\nvalues = [1.0, 2.0]\n'
+                  '[outputs]\nmetrics = ["max_response"]\n')
+    run_sweep(path, tmp_path / "s.zarr", workers=0, progress=False)
+    (tmp_path / "pulse.csv").write_text("t,a\n0,0\n0.005,300\n0.01,0\n")
+    with pytest.raises(ParameterError, match="holds the results of a different sweep"):
+        run_sweep(path, tmp_path / "s.zarr", workers=0, progress=False)

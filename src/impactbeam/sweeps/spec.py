@@ -267,6 +267,7 @@ class SweepSpec:
         out: dict[str, Any] = {
             "format": _FORMAT_VERSION,
             "base": self.base.data,
+            "samples_read": _read_samples_digest(self.base),
             "design": self.design,
             "parameters": params,
             "metrics": list(self.metrics),
@@ -394,3 +395,18 @@ def _draw(spec: SweepSpec) -> np.ndarray:
     eps = np.finfo(float).eps
     u = np.clip(u, eps, 1.0 - eps)
     return np.column_stack([p.ppf(u[:, j]) for j, p in enumerate(spec.parameters)]) if d else np.zeros((n, 0))
+
+
+def _read_samples_digest(base: Any) -> str:
+    """SHA-256 of the numbers the base scenario read from files (a trace, initial fields): the scenario's data
+    holds only their names, so a changed file had left the sweep's hash, and a resumed store, as they were."""
+    h = hashlib.sha256()
+    ex = base.excitation
+    arrays = [ex.times, ex.values] if ex.shape == "table" else []
+    for profile in (base.initial.displacement_profile, base.initial.velocity_profile):
+        if profile is not None:
+            arrays += [profile.positions, profile.values]
+    for a in arrays:
+        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    return h.hexdigest()
+
