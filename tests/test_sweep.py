@@ -436,6 +436,21 @@ def test_plot_line_and_heat_map(grid_run, tmp_path):
     plt.close(fig)
 
 
+def test_plot_selects_a_choice_parameter(tmp_path):
+    """--sel on a string parameter (contactors.0.side) ended in a traceback (a NumPy string dtype cast)."""
+    import matplotlib.pyplot as plt
+
+    text = (f'base = "{CASE3.as_posix()}"\n[parameters."contactors.0.gap"]\nvalues = ["0.1 mm", "0.3 mm"]\n'
+            '[parameters."contactors.0.side"]\nvalues = ["above", "below"]\n[parameters."solver.end_time"]\n'
+            'values = [0.03]\n[outputs]\nmetrics = ["max_response"]\n')
+    run = run_sweep(_write(tmp_path, "c.toml", text), None, workers=0, progress=False)
+    fig, ax = plt.subplots()
+    line = plot_sweep(run.dataset, "contactors.0.gap", "max_response", sel={"contactors.0.side": "below"}, ax=ax)
+    want = run.dataset["max_response"].sel({"contactors.0.side": "below"}).values.ravel() * 1e3
+    np.testing.assert_allclose(line.get_ydata(), want, rtol=1e-15)
+    plt.close(fig)
+
+
 # --------------------------------------------------------------------------- Dask
 
 

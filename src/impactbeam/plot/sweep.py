@@ -62,7 +62,7 @@ def select_cases(ds: Any, keep: Sequence[str], sel: Mapping[str, Any] | None = N
                 if abs(coord[i] - v) > 1e-6 * spacing:
                     raise ParameterError(f"--sel {dim}: {value} is not one of its values {coord.tolist()}")
             else:
-                matches = np.nonzero(coord.astype(str) == str(value))[0]
+                matches = np.nonzero([str(c) == str(value) for c in coord.tolist()])[0]  # any string dtype
                 if not matches.size:
                     raise ParameterError(f"--sel {dim}: {value!r} is not one of its values {coord.tolist()}")
                 i = int(matches[0])

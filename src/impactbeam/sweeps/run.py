@@ -282,11 +282,15 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
                            after=0.0, dynamic_ncols=True)
 
             def done(region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
-                with guard.write():
-                    writer.write(region, res)  # type: ignore[union-attr]
-                n = len(res["status"])
-                counts["computed"] += n
-                counts["failed"] += int((np.asarray(res["status"]) == FAILED).sum())
+                n, written = len(res["status"]), False
+                try:
+                    with guard.write():  # an interrupt held during the write is raised on leaving it
+                        writer.write(region, res)  # type: ignore[union-attr]
+                        written = True
+                finally:  # a batch written is counted, also when the interrupt comes right after it
+                    if written:
+                        counts["computed"] += n
+                        counts["failed"] += int((np.asarray(res["status"]) == FAILED).sum())
                 bar.advance(n)  # type: ignore[union-attr]
 
             if n_todo:
