@@ -63,7 +63,8 @@ def convergence(scenario: str, modes: str | None, max_modes: int, as_json: bool,
             study = convergence_study(sc, counts, max_modes=max_modes, progress=report)
         except ParameterError as exc:  # the API's argument "counts" is this command's --modes
             text = str(exc)
-            raise ParameterError("--modes: " + text[len("counts: "):] if text.startswith("counts: ") else text) from None
+            renamed = "--modes: " + text[len("counts: "):] if text.startswith("counts: ") else text
+            raise ParameterError(renamed) from None
     if plot is not None:
         _figure(study, plot)
     caught = take_warnings()

@@ -448,8 +448,8 @@ def _solution(pk, contactors, options, pcs, con, fc, ic, rec, status, excitation
         energy_jumps=rec.jumps[:njump].copy(), event_penetrations=rec.ev_d[:nev].copy(), status=code,
         message=message, warnings=tuple(warnings),
         t_end=t_stop if code else float(options.end_time), evaluations=int(ic[_loop.I_EVALS]),
-        n_modes=pk.n_modes, excitation=excitation, event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy(),
-                                          rec.ev_v[:nev].copy()),
+        n_modes=pk.n_modes, excitation=excitation,
+        event_arrays=(rec.ev_t[:nev].copy(), rec.ev_kind[:nev].copy(), rec.ev_c[:nev].copy(), rec.ev_v[:nev].copy()),
     )
 
 
