@@ -71,7 +71,12 @@ class _Runner:
 
         k = self.key(sc)
         if k not in self._cache:
-            res = simulate(sc)
+            from .._warnings import WarningLog, emit_user_level_warning
+
+            with WarningLog() as log:  # said again with the run they belong to
+                res = simulate(sc)
+            for text in log.messages:
+                emit_user_level_warning(f"{label or sc.name}: {text}")
             if not res.success:
                 raise SimulationError(f"{label or sc.name}: {res.message}")
             self._cache[k] = res
