@@ -219,7 +219,7 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
         )
     if dimension == "frequency":
         return _cyclic_frequency(quantity, text)
-    angle = dict(quantity.to_root_units().units._units).get("radian", 0)
+    angle = _root_powers(quantity)[1]
     value = float(quantity.to(target).magnitude)
     wanted = _ANGLE_POWER.get(dimension, 0)
     if angle == wanted or (dimension == "rotational_stiffness" and angle == 0):
@@ -234,6 +234,13 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
     raise _UnitProblem(f'"{text}" has an angle in its unit, expected {describe_dimension(dimension)}')
 
 
+def _root_powers(quantity: Any) -> tuple[dict[str, float], float, float]:
+    """The quantity in root units: the powers of its units but the radian, the radian's power, the magnitude."""
+    root = quantity.to_root_units()
+    powers = dict(root.units._units)
+    return powers, powers.pop("radian", 0), float(root.magnitude)
+
+
 def _cyclic_frequency(quantity: Any, text: str) -> float:
     """A frequency in Hz (cycles per second) from a cyclic or an angular quantity.
 
@@ -245,13 +252,10 @@ def _cyclic_frequency(quantity: Any, text: str) -> float:
     divided by 2 pi rad per cycle. ``"60 rad/s"`` is 9.549 Hz, ``"60 rpm"``
     and ``"1 cycle/s"`` are 1 Hz.
     """
-    root = quantity.to_root_units()
-    powers = dict(root.units._units)
-    angle = powers.pop("radian", 0)
+    powers, angle, magnitude = _root_powers(quantity)
     if powers != {"second": -1} or angle not in (0, 1):
         raise _UnitProblem(f'"{text}" is not a frequency (cycles or an angle per time), expected '
                            f"{describe_dimension('frequency')}")
-    magnitude = float(root.magnitude)
     return magnitude / (2.0 * math.pi) if angle == 1 else magnitude
 
 

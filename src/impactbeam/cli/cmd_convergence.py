@@ -28,14 +28,14 @@ def _counts(text: str | None) -> list[int] | None:
 
 @click.command()
 @click.argument("scenario", metavar="SCENARIO")
-@click.option("--modes", "modes", default=None, metavar="N1,N2,...",
+@click.option("--modes", "counts", default=None, metavar="N1,N2,...",
               help="Mode counts to show [default: 4, 6, 8, 12, 16, 24, 32, 48, 64 up to --max-modes].")
 @click.option("--max-modes", "max_modes", type=int, default=64, show_default=True,
               help="Largest count of the default ladder.")
 @click.option("--json", "as_json", is_flag=True, help="Print the study as JSON.")
 @click.option("--plot", "plot", default=None, metavar="FILE", help="Save the figure (e.g. .png, .pdf).")
 @handle_errors
-def convergence(scenario: str, modes: str | None, max_modes: int, as_json: bool, plot: str | None) -> None:
+def convergence(scenario: str, counts: str | None, max_modes: int, as_json: bool, plot: str | None) -> None:
     """The Table-2 metrics of SCENARIO against the number of modes, with their error estimates.
 
     Every count is run with the counts its estimate compares with (about
@@ -47,7 +47,7 @@ def convergence(scenario: str, modes: str | None, max_modes: int, as_json: bool,
     from ..model.options import MAX_MODES
 
     check_output("--plot", plot, PLOT_SUFFIXES)
-    counts = _counts(modes)
+    mode_counts = _counts(counts)  # (the option's value is "counts", as the API's argument: one message rule)
     if not 4 <= max_modes <= MAX_MODES:
         raise ParameterError(f"--max-modes: expected 4 to {MAX_MODES}, got {max_modes}")
     sc = load_with_overrides(scenario)
@@ -59,12 +59,7 @@ def convergence(scenario: str, modes: str | None, max_modes: int, as_json: bool,
 
     with progress_bar(1.0, desc="convergence", unit="", bar_format="{desc}: {percentage:3.0f}%|{bar}| "
                       "[{elapsed}<{remaining}]") as report:
-        try:
-            study = convergence_study(sc, counts, max_modes=max_modes, progress=report)
-        except ParameterError as exc:  # the API's argument "counts" is this command's --modes
-            text = str(exc)
-            renamed = "--modes: " + text[len("counts: "):] if text.startswith("counts: ") else text
-            raise ParameterError(renamed) from None
+        study = convergence_study(sc, mode_counts, max_modes=max_modes, progress=report)
     if plot is not None:
         _figure(study, plot)
     caught = take_warnings()

@@ -188,7 +188,9 @@ class FitResult:
         ex = self.scenario.excitation
         if self._override and ex.times is not None:  # the samples of the fitted excitation
             csv_path = target.with_name(f"{target.stem}_excitation.csv")
-            unit = {"base_acceleration": "m/s^2", "point_force": "N", "distributed_force": "N/m"}[ex.kind]
+            from ..model.loading import UNITS
+
+            unit = UNITS[ex.kind]
             lines = ["# excitation used by the fit (impactbeam fit)", f"time [s],{ex.kind} [{unit}]"]
             lines += [f"{t!r},{v!r}" for t, v in zip(ex.times.tolist(), ex.values.tolist())]
             write_text(csv_path, "\n".join(lines) + "\n")

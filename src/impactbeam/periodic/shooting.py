@@ -362,10 +362,8 @@ def periodic_orbit(
     else:
         res, end, n_modes = _settle(scenario, M, settle_periods)
         sol = res.solution
-        from ..result.timegrid import per_state as per_state_modes
-
         # per-state modes (solver.basis = "paper", or a beam that can move as a rigid body)
-        per_state = per_state_modes(res)
+        per_state = sol.packed.space.per_state
         prefer_free = per_state or bool(np.any(sol.packed.dash > 0.0))
         phase, free = _section_phase(sol, end - M / f, end, float(exc.start), f, prefer_free)
         pmap = StroboscopicMap(scenario, M, phase, n_modes)

@@ -39,8 +39,7 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
 
 __all__ = ["per_state", "solution_rates", "top_frequency", "scan_times", "graded_offsets", "gauss_panels", "gauss_rule",
-           "cuts",
-           "cumulative_power", "SAMPLES_PER_PERIOD", "GAUSS_NODES", "PANELS_PER_CALL"]
+           "cuts", "cumulative_power", "SAMPLES_PER_PERIOD", "GAUSS_NODES", "PANELS_PER_CALL"]
 
 #: Samples per period of the highest retained frequency in the scans of the stress and of its turning points.
 SAMPLES_PER_PERIOD = 8
