@@ -171,3 +171,27 @@ def test_to_jsonable() -> None:
     assert json.loads(text) == {"a": 1.5, "b": None, "c": None, "d": 3,
                                 "e": [{"time": 0.5, "kind": "impact", "contactor": 0}],
                                 "f": [1.0, None], "g": [1, 2]}
+
+
+def test_result_file_holds_what_the_command_reported(tmp_path: Path) -> None:
+    # Reason: a result file carries its provenance: the metrics as --json gave them (the convergence
+    # estimate, the impact statistics) and every warning of the command, not only the run's own.
+    # Case 3 on the paper's basis with 2 modes warns twice: the projections' energy (the run's own
+    # warning) and the convergence estimate's (a re-run's, given by the command).
+    scenario = tmp_path / "paper.toml"
+    text = (EXAMPLES / "case03.toml").read_text(encoding="utf-8")
+    scenario.write_text(text.replace("[solver]", '[solver]\nbasis = "paper"', 1), encoding="utf-8")
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    out = tmp_path / "r.nc"
+    proc = run("simulate", scenario, "--modes", "2", "--json", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    reported = json.loads(proc.stdout)
+    assert any("not converged in the number of modes" in w for w in reported["warnings"])
+    with xr.open_dataset(out) as ds:
+        stored = json.loads(ds.attrs["metrics"])
+        warned = ds.attrs["warnings"]
+    assert stored["convergence"] == reported["convergence"]
+    assert stored["impact_statistics"] == reported["impact_statistics"]
+    assert stored["n_impacts"] == reported["n_impacts"] and stored["modes"] == 2
+    assert warned == "; ".join(reported["warnings"])

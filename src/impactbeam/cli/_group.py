@@ -58,6 +58,12 @@ def take_warnings() -> list[str]:
     return [] if log is None else log.take()
 
 
+def pending_warnings() -> list[str]:
+    """The ImpactBeamWarnings raised so far in the running command, left to be reported (:func:`take_warnings`)."""
+    log = _WARNING_LOG.get()
+    return [] if log is None else log.messages
+
+
 def warning_lines(messages: list[str]) -> list[str]:
     """``warning: <message>`` lines for a terminal summary."""
     return [f"warning: {m}" for m in messages]

@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from .._io import PLOT_SUFFIXES, RESULT_SUFFIXES, check_output, json_text
-from ._group import fail, handle_errors, load_with_overrides, progress_bar, take_warnings
+from ._group import fail, handle_errors, load_with_overrides, pending_warnings, progress_bar, take_warnings
 
 __all__ = ["simulate"]
 
@@ -112,7 +112,7 @@ def simulate(
         metrics["seed"] = sc.excitation.seed  # drawn when the scenario gives none: reported to repeat the run
     if out is not None:
         try:
-            write_result(result, out)
+            write_result(result, out, report={**metrics, "warnings": pending_warnings()})
         except ImportError as exc:  # an optional writer backend is missing
             fail(f'--out: cannot write "{out}": {exc}', 1)
     if plot is not None:

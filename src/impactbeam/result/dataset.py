@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -42,23 +43,30 @@ def provenance(title: str, command: str, source: str) -> dict[str, str]:
     }
 
 
-def result_attrs(result: Any) -> dict[str, Any]:
+def result_attrs(result: Any, report: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The attributes of a result's files (netCDF, Parquet): provenance, scenario, metrics, solver settings.
 
     Parameters
     ----------
     result : SimulationResult
+    report : mapping, optional
+        The metrics as a command reported them (with convergence, impact
+        statistics, fatigue, seed) and, under ``"warnings"``, every warning
+        it gave: the ``metrics`` and ``warnings`` attributes then hold these
+        instead of ``result.metrics()`` and the run's own warnings.
     """
+    metrics = result.metrics() if report is None else {k: v for k, v in report.items() if k != "warnings"}
+    warned = result.warnings if report is None else report.get("warnings", result.warnings)
     return {
         **provenance(f"impactbeam simulation: {result.scenario_name}", "simulate",
                      "exact piecewise modal solution (closed form between exact events)"),
         "status": result.status,
         "message": result.message,
-        "warnings": "; ".join(result.warnings),
+        "warnings": "; ".join(warned),
         "n_modes": result.n_modes,
         "sign_convention": "w from the rest position; contactor 'below' engaged while w(a) < -gap",
         "scenario": result.scenario.to_toml() if result.scenario is not None else "",
-        "metrics": json_text(result.metrics(), indent=2),
+        "metrics": json_text(metrics, indent=2),
         **{f"solver_{k}": v for k, v in result.options.items()},
     }
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 from .._io import RESULT_SUFFIXES, atomic_path, write_netcdf
 from .._memory import check_output_size
@@ -16,7 +17,8 @@ if TYPE_CHECKING:
 __all__ = ["write_result"]
 
 
-def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
+def write_result(result: SimulationResult, path: str | os.PathLike, *,
+                 report: Mapping[str, Any] | None = None) -> Path:
     """Write the full result to ``.nc`` (netCDF4/HDF5), ``.csv`` or ``.parquet``, atomically.
 
     Parameters
@@ -24,6 +26,12 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     result : SimulationResult
     path : str or path-like
         The file; its suffix chooses the format (:data:`RESULT_SUFFIXES`).
+    report : mapping, optional
+        What was reported of the run besides its metrics (``impactbeam
+        simulate``: convergence, impact statistics, fatigue, seed, and
+        ``"warnings"``, every warning of the command): stored as the files'
+        ``metrics`` and ``warnings`` attributes in place of the run's own
+        (:func:`~impactbeam.result.dataset.result_attrs`).
 
     Returns
     -------
@@ -47,16 +55,19 @@ def write_result(result: SimulationResult, path: str | os.PathLike) -> Path:
     require({".nc": "h5netcdf", ".csv": "pandas", ".parquet": "pyarrow"}[suffix], "io", feature=f"writing {suffix}")
     path.parent.mkdir(parents=True, exist_ok=True)
     check_output_size(result.time.size, result.points.size, len(result.contactors), result.solution.n_modes)
+    from .dataset import result_attrs
+
+    attrs = result_attrs(result, report)
     if suffix == ".nc":
-        write_netcdf(result.to_xarray(), path)
+        ds = result.to_xarray()
+        ds.attrs.update(attrs)
+        write_netcdf(ds, path)
         return path
     table = result.to_dataframe()
     with atomic_path(path) as tmp:
         if suffix == ".csv":
             table.to_csv(tmp, index=False)
         else:  # Parquet keeps the attributes (pandas' attrs in its metadata); a CSV file has no place for them
-            from .dataset import result_attrs
-
-            table.attrs = {k: v if isinstance(v, (str, int, float)) else str(v) for k, v in result_attrs(result).items()}
+            table.attrs = {k: v if isinstance(v, (str, int, float)) else str(v) for k, v in attrs.items()}
             table.to_parquet(tmp, index=False)
     return path
