@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -141,6 +142,32 @@ def test_a_dashpot_stop_engaged_at_the_start_books_no_release(method, law):
     assert spring > 1e-4
     assert abs(res.energy["dashpots"][-1]) <= 1e-12 * spring and abs(res.energy["residual"][-1]) <= 1e-12 * spring
     assert abs(res.metrics(impacts=False)["energy_residual"]) <= 1e-12 * spring
+
+
+@pytest.mark.parametrize("method", ["exact", "ivp"])
+def test_a_dashpot_stop_penetrated_at_the_start_but_pulling_starts_released(method):
+    """The specimen released from a 1.6 mm tip deflection (its contactor 0.24 mm into the stop, k = 4030 N/m,
+    c = 2 N s/m) turning away at 10 rad/s: k d + c d' = 0.98 - 1.06 N < 0, so the law (never pulling) has no
+    contact under way. The run engaged the stop at t = 0 and released it at once: no event, but the ledger
+    lost the spring's k d0^2/2 (energy_residual 1.18e-4 J, all of it). Now it starts released (the penetration
+    left as after a rebound): residual 1e-18 J; tolerance 1e-12 of k d0^2/2 (round-off). Turning away at
+    2 rad/s (k d + c d' = +0.77 N) it is a contact under way, as before."""
+    sc = ib.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "specimen.toml")
+    base = {"excitation.amplitude": "0 g", "solver.end_time": 0.02, "initial.tip_displacement": "1.6 mm",
+            "initial.pivot": 0.0, "contactors.0.damping": 2.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ImpactBeamWarning)
+        warnings.filterwarnings("ignore", "initial.angular_velocity: the projection", ImpactBeamWarning)  # 0.9 %
+        pulling = ib.simulate(sc.with_values({**base, "initial.angular_velocity": -10.0}), method=method)
+        pushing = ib.simulate(sc.with_values({**base, "initial.angular_velocity": -2.0}), method=method)
+    a = sc.contactors[0].position
+    d0 = float(pulling.displacement([a], [0.0])[0, 0]) - sc.contactors[0].gap
+    spring = 0.5 * 4030.0 * d0**2
+    assert spring == pytest.approx(1.18e-4, rel=0.01)
+    assert pulling.events[0].time > 0.01 and pulling.events[0].kind == "impact"
+    assert abs(pulling.metrics(impacts=False)["energy_residual"]) <= 1e-12 * spring
+    assert pushing.events[0].time == 0.0 and pushing.events[0].kind == "impact"
+    assert abs(pushing.metrics(impacts=False)["energy_residual"]) <= 1e-12 * spring
 
 
 def _pinned_on_a_stiff_stop(basis: str, modes: int) -> ib.Scenario:

@@ -282,6 +282,20 @@ def contactor_rows(s, mask, RW, gap, side, kst, dash, phase, V, U, base, rowc, r
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def _released_at_start(t, c, mask, g, dg, dash, kst, tol_h):  # pragma: no cover - compiled
+    """Whether free dashpot contactor ``c``, penetrated at t = 0, starts released (its force ``k d + c d'`` pulls).
+
+    ``g, dg``: its opening ``-d`` and slope ``-d'`` in the free state. The law
+    never pulls, so such a contact is not under way: it starts as after a
+    release that left a penetration (``phase``), and engages if its force
+    turns to pushing before the penetration is gone.
+    """
+    if t != 0.0 or (mask >> c) & 1 or dash[c] <= 0.0 or g >= -tol_h:
+        return False
+    return g + dash[c] / kst[c] * dg > 0.0
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def _judge_start(ic, fc, g, nr, rowc, V, U, base, dec, om, eta, deta, lA, lB, lD, lE, AL, Om, phi, toggles,
                  tol_h, dvec, mag, dwork):  # pragma: no cover - compiled
     """Row to act on at the segment start (inconsistent, or departing into its stop), or -1."""
@@ -406,6 +420,9 @@ def _walk(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_from,
                 c = rowc[r_bad]
                 if rowk[r_bad] == ROW_PHASE:
                     phase[c] = 0  # the penetration left by a release is gone: a plain opening from here
+                    continue
+                if _released_at_start(t, c, smask[s], g[r_bad], dg[r_bad], dash, kst, tol_h):
+                    phase[c] = 1  # penetrated at the start but pulling: released, as after a rebound
                     continue
                 alpha_at(AL, 0.0, Om, phi, alpha)
                 to_modal(gen[s], G[s], eta, deta, alpha, own_e, own_d)

@@ -240,6 +240,18 @@ class _Reference:
                 turns.append(r)
         return wrong, turns, below
 
+    def _pulls_at_start(self, st: StateModel, engaged: tuple[int, ...], c: int, eta: np.ndarray,
+                        deta: np.ndarray) -> bool:
+        """Free dashpot contactor ``c`` penetrated at t = 0 with a pulling force ``k d + c d'``: starts released.
+
+        The engine's rule (``_loop._released_at_start``).
+        """
+        if c in engaged or self.dash[c] <= 0.0:
+            return False
+        pen = self.side[c] * float(st.W_contact[c] @ eta) - self.gap[c]
+        rate = self.side[c] * float(st.W_contact[c] @ deta)
+        return pen > self.tol and pen + self.dash[c] / self.stiff[c] * rate < 0.0
+
     def _shifted(self, ev):
         """The terminal event ``ev`` moved by the touch tolerance: it fires where the row passes ``-tol``."""
         tol = self.tol
@@ -348,6 +360,9 @@ class _Reference:
             wrong, turns, below = self._judge_start(evs, rows, t, y0, rhs, just, judged)
             if wrong and rows[wrong[0]][1] == "phase":
                 phase[rows[wrong[0]][0]] = False  # the penetration left by a release is gone: a plain opening
+                continue
+            if wrong and t == 0.0 and self._pulls_at_start(st, engaged, rows[wrong[0]][0], eta, deta):
+                phase[rows[wrong[0]][0]] = True  # penetrated but pulling: released, as after a rebound
                 continue
             for r in below:
                 evs[r] = self._shifted(evs[r])
