@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -495,3 +496,41 @@ def test_convergence_command_json_table_and_figure(tmp_path):
                        (["--modes", "0"], "--modes")):  # the option as typed (the API's argument is counts)
         r = runner.invoke(main, ["convergence", case, *bad])
         assert r.exit_code == 2 and r.stderr.startswith(f"error: {field}: ") and "Traceback" not in r.output
+
+
+def _specimen_dict(**over) -> dict:
+    d = {"beam": {"length": 0.1092, "width": 0.00993, "height": 0.00303, "youngs_modulus": 1834e6,
+                  "density": 951.98},
+         "damping": {"free": 0.0, "contact": 0.0}, "solver": {"modes": 8, "time_step": 1e-5}}
+    d.update(over)
+    return d
+
+
+def test_a_response_that_only_moves_towards_the_stop_is_no_false_alarm():
+    """u never positive: max_response is the start's 0 (to round-off, 1e-20 m) and t_max anywhere u is 0.
+
+    A tip step force of 0.05 N towards a stop 0.5 mm below the tip, the run ending at 4 ms, before the first
+    impact (4.24 ms): the tip moves 0.45 mm. The run warned that "the response is only ~1.3e-20 m" and that
+    max_response was not converged (estimate 0.94, a change of round-off over round-off). A free-free beam
+    without contactors under the Case 3 pulse (u = w at the first output point never positive, min -31.6 mm)
+    warned that t_max (5e-11 s, round-off) was not converged (0.05). The displacements' changes are measured
+    against the gap too, and t_max's not at all when max_response is zero to that floor: no warning; measured
+    estimates of max_response 4e-10 and 5e-20 (round-off, ~2e-19 m, over 1e-6 of the gap or of min_response),
+    bounded here by 1e-6, far below any tolerance and far above round-off."""
+    toward = ib.parse_scenario(_specimen_dict(
+        contactors=[{"position": 0.1092, "stiffness": 4030.0, "gap": 5e-4, "side": "below"}],
+        excitation={"kind": "point_force", "shape": "step", "amplitude": -0.05, "position": 0.1092},
+        solver={"modes": 8, "time_step": 1e-5, "end_time": 0.004}))
+    free_free = ib.parse_scenario(_specimen_dict(
+        supports={"left": "free", "right": "free"}, damping={"free": 0.011, "contact": 0.02},
+        excitation={"kind": "base_acceleration", "shape": "half_sine", "amplitude": "15 g", "duration": "15 ms"},
+        solver={"modes": 8, "time_step": 1e-5, "end_time": 0.03}))
+    for sc in (toward, free_free):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", ib.ImpactBeamWarning)
+            res = ib.simulate(sc)
+            m = res.metrics(impacts=False)
+            conv = res.estimate_convergence()
+        assert abs(m["max_response"]) < 1e-15 and res.converged
+        assert conv["max_response"] < 1e-6 and conv["t_max"] == 0.0
+    assert ib.simulate(toward).w[:, 0].min() == pytest.approx(-4.54e-4, rel=0.01)

@@ -30,7 +30,7 @@ from .model.starting import InitialCondition, Preload
 from .result import SimulationResult
 from .scenario.checks import check_response, check_run
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
-from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, estimate
+from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, estimate, length_scale
 
 if TYPE_CHECKING:
     from .scenario import Scenario
@@ -223,7 +223,7 @@ def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> Simul
         done[n] = res.metrics()
         counts = coarser_counts(n)
         if all(c in done for c in counts):
-            metrics, peaks = estimate(done[n], [done[c] for c in counts])
+            metrics, peaks = estimate(done[n], [done[c] for c in counts], length_scale(res.contactors))
             res.set_convergence(metrics, peaks, counts)
             if max(metrics.values()) < tolerance:
                 break
@@ -282,7 +282,7 @@ def convergence_study(
     for n in shown:
         coarse = coarser_counts(n)
         if coarse:
-            est, peaks = estimate(table[n], [table[c] for c in coarse])
+            est, peaks = estimate(table[n], [table[c] for c in coarse], length_scale(scenario.contactors))
             estimates[n], peak_estimates[n] = est, [float(p) for p in peaks]
         else:
             estimates[n] = peak_estimates[n] = None

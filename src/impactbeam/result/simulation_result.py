@@ -157,7 +157,7 @@ class SimulationResult:
         """
         if "_convergence" not in self.__dict__:
             from .._warnings import emit_user_level_warning as warn
-            from ..solver.convergence import estimate_by_reruns
+            from ..solver.convergence import estimate_by_reruns, length_scale
 
             if self.rerun is None or self.n_modes <= 1:
                 if self.rerun is not None:  # one mode: nothing coarser to compare with, said, not silent
@@ -165,7 +165,7 @@ class SimulationResult:
                     warn(self.warnings[-1])
                 return None
             self.set_convergence(*estimate_by_reruns(self.metrics(), self.rerun, self.n_modes, self.end_time,
-                                                     progress))
+                                                     progress, length_scale(self.contactors)))
             if not self.converged:
                 warn(self.warnings[-1])
         return self.__dict__["_convergence"]
@@ -499,6 +499,13 @@ class SimulationResult:
                    default=0.0)
         sc = self.scenario
         driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
+        if driven and peak < 1e-9 * self.beam.length and self.contactors:
+            # u may only have moved towards the stop, without reaching it (max_response the start's 0,
+            # min_response undefined): the least u over the run then says how large the response is
+            from .metrics import response_point
+
+            x, sign = response_point(self.contactors, self.points)
+            peak = max(peak, float(self.solution.extrema([(x, 0.0, self.solution.t_end, -sign, 0.0, None)])[0, 0]))
         if driven and peak < 1e-9 * self.beam.length:
             from .._warnings import emit_user_level_warning
 

@@ -11,8 +11,12 @@ impact: the largest change from the runs with the two largest counts up to
 
 * a metric: ``|m_N - m_c| / scale`` with ``scale`` the larger magnitude of the
   two values (a displacement at least ``1e-6`` of the largest displacement
-  metric, a time at least 1 ns); a metric defined at one count and undefined
-  at the other counts as 1;
+  metric and of the first contactor's gap, a time at least 1 ns); a metric
+  defined at one count and undefined at the other counts as 1; ``t_max``
+  counts as unchanged when ``max_response`` is zero to that floor in both
+  runs (``u`` never positive: its largest value is the start's 0, reached
+  again wherever ``u`` returns to 0, so its time is not a converging
+  quantity);
 * ``n_impacts``: the larger of the change of the count and the number of
   impacts without an overlapping impact of the same contactor in the other
   run (an impact that appears or vanishes with the modes), over the count;
@@ -55,7 +59,7 @@ import numpy as np
 
 __all__ = [
     "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "NO_ESTIMATE", "ConvergenceStudy", "coarser_counts", "estimate",
-    "estimate_by_reruns", "impact_changes", "relative_changes", "worst",
+    "estimate_by_reruns", "impact_changes", "length_scale", "relative_changes", "worst",
 ]
 
 #: The counts an estimate compares with: for ``N``, the two largest up to ``3 N / 4``.
@@ -130,7 +134,7 @@ def _unmatched(new: Sequence[Mapping[str, Any]], old: Sequence[Mapping[str, Any]
     return sum(j < 0 for j in _partners(a, b)) + sum(j < 0 for j in _partners(b, a))
 
 
-def relative_changes(new: Mapping[str, Any], old: Mapping[str, Any]) -> dict[str, float]:
+def relative_changes(new: Mapping[str, Any], old: Mapping[str, Any], length: float = 0.0) -> dict[str, float]:
     """Relative change of each convergence metric from ``old`` to ``new`` (see the module docstring).
 
     Parameters
@@ -138,8 +142,13 @@ def relative_changes(new: Mapping[str, Any], old: Mapping[str, Any]) -> dict[str
     new, old : mapping
         Metrics (``result.metrics()``); with an ``"impacts"`` list in both,
         ``n_impacts`` also counts the impacts that appear or vanish.
+    length : float, [m]
+        A length the displacements are also measured against: the first
+        contactor's gap (:func:`length_scale`).
     """
-    disp = max((abs(new[k]) for k in _DISPLACEMENTS if new.get(k) is not None), default=0.0)
+    disp = max(max((abs(new[k]) for k in _DISPLACEMENTS if new.get(k) is not None), default=0.0), length)
+    floor = _DISPLACEMENT_FLOOR * disp
+    flat = all(m.get("max_response") is not None and abs(m["max_response"]) <= floor for m in (new, old))
     out: dict[str, float] = {}
     for key in CONVERGENCE_METRICS:
         a, b = new.get(key), old.get(key)
@@ -149,21 +158,32 @@ def relative_changes(new: Mapping[str, Any], old: Mapping[str, Any]) -> dict[str
         if a is None or b is None:
             out[key] = 1.0
             continue
-        change = abs(a - b)
+        change = 0.0 if (key == "t_max" and flat) else abs(a - b)
         scale = max(abs(a), abs(b))
         if key == "n_impacts":
             if "impacts" in new and "impacts" in old:
                 change = max(change, _unmatched(new["impacts"], old["impacts"]))
             scale = max(scale, 1.0)
         elif key in _DISPLACEMENTS:
-            scale = max(scale, _DISPLACEMENT_FLOOR * disp)
+            scale = max(scale, floor)
         else:
             scale = max(scale, _TIME_FLOOR)
         out[key] = change / scale if scale > 0 else (0.0 if change == 0 else math.inf)
     return out
 
 
-def estimate(new: Mapping[str, Any], coarser: Sequence[Mapping[str, Any]]) -> tuple[dict[str, float], np.ndarray]:
+def length_scale(contactors: Sequence[Any]) -> float:
+    """The length the displacement metrics' changes are also measured against: the first contactor's gap.
+
+    Parameters
+    ----------
+    contactors : sequence of Contactor
+    """
+    return float(contactors[0].gap) if contactors else 0.0
+
+
+def estimate(new: Mapping[str, Any], coarser: Sequence[Mapping[str, Any]],
+             length: float = 0.0) -> tuple[dict[str, float], np.ndarray]:
     """The error estimate of a run from runs with fewer modes: per metric, and per impact's peak force.
 
     Parameters
@@ -172,6 +192,8 @@ def estimate(new: Mapping[str, Any], coarser: Sequence[Mapping[str, Any]]) -> tu
         Metrics of the run (``result.metrics()``, with ``"impacts"``).
     coarser : sequence of mapping
         Metrics of the runs with fewer modes (at least one).
+    length : float, [m]
+        :func:`length_scale` of the run's contactors.
 
     Returns
     -------
@@ -180,7 +202,7 @@ def estimate(new: Mapping[str, Any], coarser: Sequence[Mapping[str, Any]]) -> tu
     peak_forces : ndarray, (n_impacts,)
         The largest relative change of each impact's peak force.
     """
-    changes = [relative_changes(new, old) for old in coarser]
+    changes = [relative_changes(new, old, length) for old in coarser]
     metrics = {key: max(c[key] for c in changes) for key in CONVERGENCE_METRICS}
     impacts = new.get("impacts") or []
     peaks = np.zeros(len(impacts))
@@ -199,7 +221,7 @@ def estimate(new: Mapping[str, Any], coarser: Sequence[Mapping[str, Any]]) -> tu
 
 
 def estimate_by_reruns(metrics: Mapping[str, Any], rerun: Callable[..., Any], n_modes: int, end_time: float,
-                       progress: Callable[[float], None] | None = None
+                       progress: Callable[[float], None] | None = None, length: float = 0.0
                        ) -> tuple[dict[str, float], np.ndarray, tuple[int, ...]]:
     """:func:`estimate` of a run with ``n_modes`` modes against its re-runs at :func:`coarser_counts`.
 
@@ -216,6 +238,8 @@ def estimate_by_reruns(metrics: Mapping[str, Any], rerun: Callable[..., Any], n_
     progress : callable, optional
         Called with the re-runs done so far (fractions within one by its
         simulated time).
+    length : float, [m]
+        :func:`length_scale` of the run's contactors.
 
     Returns
     -------
@@ -234,7 +258,7 @@ def estimate_by_reruns(metrics: Mapping[str, Any], rerun: Callable[..., Any], n_
             else:
                 res = rerun(c, report=lambda t, i=i: progress(i + t / end_time))
             coarse.append(res.metrics())
-    changes, peaks = estimate(metrics, coarse)
+    changes, peaks = estimate(metrics, coarse, length)
     return changes, peaks, counts
 
 
