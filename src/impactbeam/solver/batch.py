@@ -235,7 +235,8 @@ def integrate_batch(
             moved = (int(warn[k, 0]), int(warn[k, 5]), options[k].modes, int(warn[k, 1]), float(warn[k, 3]),
                      float(warn[k, 4]), float(warn[k, 2]))
         warnings.append(run_warnings(int(status[k]), float(t_stop[k]), int(out[k, 8]), float(options[k].end_time),
-                                     moved, (float(warn[k, 6]), float(warn[k, 7]), int(warn[k, 5]), options[k].modes)))
+                                     moved, (float(warn[k, 6]), float(warn[k, 7]), int(warn[k, 5]), options[k].modes),
+                                     (excitations[k], pk.space.state(()).modes.omega, options[k].modes)))
     return BatchResult(out, status, t_stop, messages, warnings, errors)
 
 

@@ -76,7 +76,8 @@ class IvpSolution(PiecewiseSolution):
         self.event_penetrations = penetrations
         self.status = status
         self.message = message
-        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time), moved, energy))
+        self.warnings = tuple(run_warnings(status, t_end, len(events), float(ref.opt.end_time), moved, energy,
+                                           (ref.excitation, ref.space.state(()).modes.omega, ref.opt.modes)))
         self.t_end = t_end
         self.contactors = ref.contactors
         self.dashpots = ref.dash
