@@ -534,3 +534,14 @@ def test_a_response_that_only_moves_towards_the_stop_is_no_false_alarm():
         assert abs(m["max_response"]) < 1e-15 and res.converged
         assert conv["max_response"] < 1e-6 and conv["t_max"] == 0.0
     assert ib.simulate(toward).w[:, 0].min() == pytest.approx(-4.54e-4, rel=0.01)
+
+
+def test_the_study_recommends_the_count_auto_stops_at():
+    """Case 3: the 4-mode estimate (against 2 and 3 modes) is 1.9e-4, below the tolerance 2e-3, and the study
+    said converged_modes = 4 while modes = "auto" (which decides on no estimate against fewer than 4 modes)
+    returns 8. The study now follows auto's rule."""
+    sc = ib.load_scenario(EXAMPLES / "case03.toml")
+    study = convergence_study(sc, [4, 6, 8, 12])
+    assert max(study.estimates[4].values()) < sc.solver.tolerance
+    auto = ib.simulate(sc.with_values({"solver.modes": "auto"}))
+    assert study.converged_count == auto.n_modes == 8

@@ -30,7 +30,7 @@ from .model.starting import InitialCondition, Preload
 from .result import SimulationResult
 from .scenario.checks import check_response, check_run
 from .solver import ModalState, PiecewiseSolution, basis_signature, integrate
-from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, coarser_counts, estimate, length_scale
+from .solver.convergence import AUTO_COUNTS, ConvergenceStudy, can_decide, coarser_counts, estimate, length_scale
 
 if TYPE_CHECKING:
     from .scenario import Scenario
@@ -222,7 +222,7 @@ def _auto_modes(run: Callable[..., SimulationResult], tolerance: float) -> Simul
         res = nxt
         done[n] = res.metrics()
         counts = coarser_counts(n)
-        if all(c in done for c in counts):
+        if can_decide(n):
             metrics, peaks = estimate(done[n], [done[c] for c in counts], length_scale(res.contactors))
             res.set_convergence(metrics, peaks, counts)
             if max(metrics.values()) < tolerance:

@@ -58,8 +58,8 @@ from typing import Any
 import numpy as np
 
 __all__ = [
-    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "NO_ESTIMATE", "ConvergenceStudy", "coarser_counts", "estimate",
-    "estimate_by_reruns", "impact_changes", "length_scale", "relative_changes", "worst",
+    "AUTO_COUNTS", "CONVERGENCE_METRICS", "LADDER", "NO_ESTIMATE", "ConvergenceStudy", "can_decide", "coarser_counts",
+    "estimate", "estimate_by_reruns", "impact_changes", "length_scale", "relative_changes", "worst",
 ]
 
 #: The counts an estimate compares with: for ``N``, the two largest up to ``3 N / 4``.
@@ -88,6 +88,20 @@ def coarser_counts(n: int) -> tuple[int, ...]:
         Modes per state of the run.
     """
     return tuple(c for c in LADDER if 4 * c <= 3 * n)[-2:]
+
+
+def can_decide(n: int) -> bool:
+    """Whether the estimate of a run with ``n`` modes may decide convergence: both its coarser counts are
+    among :data:`AUTO_COUNTS` (4 modes or more; ``modes = "auto"`` stops on no estimate against 2 or 3 modes,
+    so from 8 modes on along its ladder, and :attr:`ConvergenceStudy.converged_count` follows the same rule).
+
+    Parameters
+    ----------
+    n : int
+        Modes per state of the run.
+    """
+    counts = coarser_counts(n)
+    return bool(counts) and all(c in AUTO_COUNTS for c in counts)
 
 
 def _intervals(impacts: Sequence[Mapping[str, Any]]) -> list[tuple[int, float, float, float]]:
@@ -310,10 +324,13 @@ class ConvergenceStudy:
 
     @property
     def converged_count(self) -> int | None:
-        """The smallest count whose every Table-2 estimate is below the tolerance (None if none is)."""
+        """The smallest count whose every Table-2 estimate is below the tolerance (None if none is).
+
+        Only counts whose estimate may decide (:func:`can_decide`): the count ``modes = "auto"`` would stop at.
+        """
         for n in self.counts:
             est = self.estimates.get(n)
-            if est is not None and max(est.values()) < self.tolerance:
+            if est is not None and can_decide(n) and max(est.values()) < self.tolerance:
                 return n
         return None
 
