@@ -165,8 +165,12 @@ def _check_system(beam: Beam, contactors: tuple[Contactor, ...], excitation: Exc
         raise ParameterError("output.points: at least one output point is needed")
     if np.any(pts_arr < 0) or np.any(pts_arr > beam.length * (1 + 1e-12)):
         raise ParameterError(f"output.points: every point must lie on the beam [0, {beam.length:g}] m")
-    if excitation.kind == "point_force" and excitation.position is not None and excitation.position > beam.length * (1 + 1e-12):
-        raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length {beam.length:g} m)")
+    if excitation.kind == "point_force" and excitation.position is not None:
+        if excitation.position > beam.length * (1 + 1e-12):
+            raise ParameterError(f"excitation.position: {excitation.position:g} m is off the beam (length "
+                                 f"{beam.length:g} m)")
+        if excitation.active:
+            beam.require_free(excitation.position, "excitation.position", "the force does no work on the beam")
     _check_distinct(contactors)
     # what a scenario file is refused for, refused for objects too (a load whose response overflows, a run
     # whose exact extrema would take out of proportion)

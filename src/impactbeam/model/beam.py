@@ -402,6 +402,24 @@ class Beam:
         """
         return 0.5 * self._piece_values(x, "height")
 
+    def require_free(self, x: float, key: str, consequence: str) -> None:
+        """ParameterError naming ``key`` when ``x`` is where a support holds ``w = 0`` (:meth:`fixed_at`).
+
+        Parameters
+        ----------
+        x : float, [m]
+        key : str
+            The input given there (``contactors.0.position``).
+        consequence : str
+            Why that is refused (``the contactor can never act``).
+        """
+        held = self.fixed_at(x)
+        if held is not None:
+            raise ParameterError(
+                f"{key}: {x:.10g} m is at {held}, where w = 0 (within {MERGE_DISTANCE:g} L), so {consequence}; "
+                f"remove it, or place it at least {MERGE_DISTANCE * self.length:.3g} m from the support"
+            )
+
     def fixed_at(self, x: float) -> str | None:
         """What holds the deflection at ``x`` at zero, or None.
 
@@ -553,10 +571,4 @@ class Contactor:
             raise ParameterError(
                 f"{name}.position: {self.position:g} m is off the beam (length {beam.length:g} m)"
             )
-        held = beam.fixed_at(self.position)
-        if held is not None:
-            raise ParameterError(
-                f"{name}.position: {self.position:g} m is at {held}, where w = 0 (within {MERGE_DISTANCE:g} L), "
-                "so the contactor can never act; remove it, or place it at least "
-                f"{MERGE_DISTANCE * beam.length:.3g} m from the support"
-            )
+        beam.require_free(self.position, f"{name}.position", "the contactor can never act")
