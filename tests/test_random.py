@@ -48,6 +48,14 @@ def test_spectral_density_units():
     assert to_si("1 (N/m)^2/Hz", "force_per_length_psd", "k") == 1.0
     with pytest.raises(ib.ScenarioError, match=r"excitation\.psd\.0\.1: .*velocity.*spectral density"):
         to_si("0.01 g/Hz", "acceleration_psd", "excitation.psd.0.1")
+    # g squared with a superscript is standard gravity squared too; "mg" is a milligram, and the message says
+    # how g is read (it said "[mass] ** 2 * [time]" alone)
+    assert to_si("0.01 g²/Hz", "acceleration_psd", "k") == pytest.approx(0.01 * STANDARD_GRAVITY**2, rel=1e-15)
+    with pytest.raises(ib.ScenarioError, match=r'g written alone is standard gravity here, "0\.01 g\^2/Hz"; "mg" is a '
+                                               r"milligram"):
+        to_si("1 mg^2/Hz", "acceleration_psd", "excitation.psd.0.1")
+    with pytest.raises(ib.ScenarioError, match=r'standard gravity here, "15 g"'):
+        to_si("15 mg", "acceleration", "excitation.amplitude")
 
 
 def test_synthesis_repeats_bit_for_bit_and_streams_are_spawned_children():

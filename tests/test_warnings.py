@@ -43,8 +43,12 @@ WARNED = [
                  "excitation.start: the excitation starts at 0.02 s, at or after solver.end_time = 0.01 s",
                  id="excitation-after-end"),
     pytest.param(BEAM.replace("length = 0.1092", 'length = "0.1092"') + SHORT + PULSE,
-                 'beam.length: "0.1092" is a number written as a string without a unit; it is taken as SI (m)',
+                 'beam.length: "0.1092" is a number written as a string without a unit; it is taken as SI (m). '
+                 'Write it as a number (0.1092) or with its unit (e.g. "0.1092 m")',
                  id="numeric-string"),
+    # the example unit is the key's (a stress was shown as "800 mm")
+    pytest.param(BEAM.replace('youngs_modulus = 1834e6', 'youngs_modulus = "1834e6"') + SHORT + PULSE,
+                 'or with its unit (e.g. "1834e6 Pa")', id="numeric-string-stress"),
     pytest.param(BEAM + PULSE + SHORT + "event_tolerance = 1e-6\n",
                  "solver.event_tolerance: 1e-06 s is more than 1e-3 of solver.time_step", id="event-tolerance"),
 ]

@@ -120,7 +120,7 @@ _NUMBER_UNIT = re.compile(
     r"^\s*(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?i:inf(?:inity)?|nan))(?![\d.,])"
     r"\s*(?P<unit>\S.*?)\s*$"
 )
-_GRAVITY_G = re.compile(r"(?<![\w.])g(?![\w.])")
+_GRAVITY_G = re.compile(r"(?<![\w.])g(?![^\W²³]|\.)")  # g alone, or squared with a superscript (g²)
 
 
 def registry() -> Any:
@@ -214,8 +214,12 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
     dim = _dimension(dimension)
     target = ureg.parse_units(dim.pint_unit)
     if quantity.dimensionality != target.dimensionality:
+        hint = ""
+        if dimension in _GRAVITY_DIMENSIONS and "g" in text and "[mass]" in str(quantity.dimensionality):
+            example = "15 g" if dimension == "acceleration" else "0.01 g^2/Hz"
+            hint = f' (g written alone is standard gravity here, "{example}"; "mg" is a milligram)'
         raise _UnitProblem(
-            f'"{text}" is {_name_of(quantity.dimensionality)}, expected {describe_dimension(dimension)}'
+            f'"{text}" is {_name_of(quantity.dimensionality)}, expected {describe_dimension(dimension)}{hint}'
         )
     if dimension == "frequency":
         return _cyclic_frequency(quantity, text)

@@ -312,5 +312,5 @@ def warn_numeric_strings(raw: Mapping[str, Any]) -> None:
             continue
         emit_user_level_warning(
             f'{key}: "{value}" is a number written as a string without a unit; it is taken as SI ({unit}). '
-            f"Write it as a number ({value.strip()}) or with its unit (e.g. \"{value.strip()} mm\")"
+            f"Write it as a number ({value.strip()}) or with its unit (e.g. \"{value.strip()} {unit}\")"
         )
