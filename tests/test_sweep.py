@@ -422,6 +422,11 @@ def test_plot_line_and_heat_map(grid_run, tmp_path):
     assert r.exit_code == 2 and "not one of its values" in r.stderr
     r = runner.invoke(_group(), ["plot", str(out), "--x", "beam.height", "--metric", "max_response"])
     assert r.exit_code == 2 and "not a parameter" in r.stderr
+    # the per-case warnings are text, no metric: refused as such (it was a traceback), and not offered
+    r = runner.invoke(_group(), ["plot", str(out), "--x", "excitation.duration", "--metric", "warnings"])
+    assert r.exit_code == 2 and "is not in the results" in r.stderr and "Traceback" not in r.output
+    offered = r.stderr.split("(use ")[1]
+    assert "warnings" not in offered and "message" not in offered and "max_response" in offered
 
     import matplotlib.pyplot as plt
 

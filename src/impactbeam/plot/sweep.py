@@ -110,8 +110,8 @@ def plot_sweep(
     """
     plt = require("matplotlib.pyplot", "plot")
 
-    if metric not in ds.data_vars or metric in ("status", "message", "w"):
-        names = [v for v in ds.data_vars if v not in ("status", "message", "w")]
+    names = sorted(v for v in ds.data_vars if v not in ("status", "w") and np.issubdtype(ds[v].dtype, np.number))
+    if metric not in names:  # the status, the messages and warnings (text) and the histories are no metrics
         raise ParameterError(f'--metric: "{metric}" is not in the results (use {", ".join(names)})')
     for opt, name in (("--x", x), ("--y", y)):
         if name is not None and name not in ds.coords:

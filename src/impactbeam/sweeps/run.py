@@ -333,7 +333,14 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
 
 
 def _worker_start() -> None:
-    """A local worker leaves SIGINT to the sweep's process (which stops it) and uses one BLAS thread."""
+    """A local worker leaves SIGINT and SIGTERM to the sweep's process (which stops it) and uses one BLAS thread.
+
+    It runs in a process group of its own: a signal sent to the sweep's group (a terminal's Ctrl-C, ``timeout``,
+    a batch scheduler's SIGTERM) reaches the sweep's process alone, which stops the workers between writes. A
+    worker killed by a group SIGTERM while it held the pool's task-queue lock left the sweep waiting for that
+    lock for good.
+    """
+    os.setpgrp()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
