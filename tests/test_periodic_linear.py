@@ -155,3 +155,24 @@ def test_a_transient_aliased_into_a_longer_period_is_not_one():
     assert ss.period == 1 and ss.settled_after > 100
     # tolerance: the period test's 1e-4 of the strobe's scale, what "settled" means
     assert abs(ss.strobe[-1] - orbit.strobe[0]) < 1e-4 * max(abs(ss.max), abs(ss.min))
+
+
+def test_a_transient_whose_mean_mismatch_starts_within_the_test_is_still_settling():
+    """75 Hz continued from 70 Hz: the strobe converges onto a period-1 orbit, its lag-1 mismatch falling from
+    2.7e-5 (mean over the record's first half) to 1.7e-7 (second half) of the scale, while its largest early value
+    (1.7e-4) fails the test: lag 5 happened to pass (9.7e-5) and the record was reported as period 5 with 5 impacts
+    per period, without a warning; the check for a still-settling record asked the first half's *mean* to fail
+    the test. It now asks its largest value: the run goes on and ends on period 1, one impact per period, where
+    400 settling periods put it too (and the orbit closes: the shooting method's fixed point)."""
+    from impactbeam.periodic.bifurcation import bifurcation
+
+    sc = ib.load_scenario(EXAMPLES / "periodic" / "specimen_harmonic.toml")
+    d = bifurcation(sc, "excitation.frequency", [70.0, 75.0], sweep="up")
+    at75 = d.points[1].state
+    assert at75.period == 1 and at75.impacts_per_period == 1.0 and at75.settled_after > 100 and not d.warnings
+    longer = bifurcation(sc, "excitation.frequency", [70.0, 75.0], sweep="up", settle_periods=400).points[1].state
+    assert longer.period == 1 and longer.settled_after == 400
+    orbit = ib.periodic_orbit(sc.with_values({"excitation.frequency": 75.0}), multiple=1, settle_periods=150)
+    assert orbit.converged and orbit.stable
+    # tolerance: the period test's 1e-4 of the strobe's scale, what "settled" means
+    assert abs(at75.strobe[-1] - orbit.strobe[0]) < 1e-4 * max(abs(at75.max), abs(at75.min))

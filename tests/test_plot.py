@@ -289,7 +289,7 @@ def test_frequency_response_axis_holds_the_impacting_branch_not_the_linear_peak(
     lin = 1e-3 / (np.abs(f - 57.0) + 0.3)  # a sharp linear peak, 3.3 mm
     fr = SimpleNamespace(frequency=np.concatenate([f, f[::-1]]), direction=np.array(["up"] * 15 + ["down"] * 15),
                          max=np.full(30, 0.4e-3), min=np.full(30, -0.6e-3), linear=np.concatenate([lin, lin[::-1]]),
-                         point=0.0529)
+                         point=0.0529, linear_curve=(np.empty(0), np.empty(0)))  # no fine grid: the swept values
     h = plot.plot_frequency_response(fr)
     lo, hi = h.axes[0].get_ylim()
     assert -0.8 < lo < -0.6 and 0.4 < hi < 0.6  # mm: the extremes with a margin

@@ -603,3 +603,14 @@ def test_a_changed_trace_file_is_another_sweep(tmp_path):
     (tmp_path / "pulse.csv").write_text("t,a\n0,0\n0.005,300\n0.01,0\n")
     with pytest.raises(ParameterError, match="holds the results of a different sweep"):
         run_sweep(path, tmp_path / "s.zarr", workers=0, progress=False)
+
+
+def test_an_interrupt_before_the_first_case_says_nothing_was_written():
+    # a sweep or an ensemble interrupted before its store existed said "0 of 0 cases are in m2.zarr"
+    from impactbeam.sweeps import SweepInterrupted
+
+    early = SweepInterrupted(signal.SIGINT)
+    assert early.summary("cases", "m2.zarr") == "interrupted before the first of the cases ran: nothing was written"
+    later = SweepInterrupted(signal.SIGTERM, 3, 36)
+    assert later.summary("seeds", "rnd") == ("interrupted: 3 of 36 seeds are in rnd; run the same command again to "
+                                             "finish")

@@ -61,8 +61,7 @@ def random_command(scenario: str, seeds: int, workers: int | None, scheduler: st
     try:
         res = random_response(sc, seeds, workers, scheduler=scheduler, out=out, progress=not no_progress)
     except SweepInterrupted as exc:
-        click.echo(f"interrupted: {exc.done} of {exc.total} seeds are in {out or 'memory (lost: no --out)'}; "
-                   "run the same command again to finish", err=True)
+        click.echo(exc.summary("seeds", out or "memory (lost: no --out)"), err=True)
         sys.exit(128 + exc.signum)
     caught = take_warnings()
     data = {**res.to_dict(), "warnings": caught}

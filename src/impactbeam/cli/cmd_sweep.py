@@ -71,10 +71,7 @@ def sweep_command(
             progress=not no_progress, on_error=on_error,  # type: ignore[arg-type]
         )
     except SweepInterrupted as exc:
-        click.echo(
-            f"interrupted: {exc.done} of {exc.total} cases are in {out}; run the same command again to finish",
-            err=True,
-        )
+        click.echo(exc.summary("cases", str(out)), err=True)
         sys.exit(128 + exc.signum)
     failed = "" if not run.failed else f" ({run.failed} failed: see the status and message variables)"
     ds = run.dataset

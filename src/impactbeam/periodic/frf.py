@@ -51,6 +51,10 @@ class FrequencyResponse:
         ``|H| A``: the amplitude without contact at the same frequencies.
     point : float, [m]
     warnings : list of str
+    linear_curve : (ndarray, ndarray), ([Hz], [m])
+        ``|H| A`` on a fine grid over the swept range, its peak located to
+        1e-9 of its frequency (the swept values alone may miss a resonance
+        between them).
     """
 
     diagram: BifurcationDiagram = field(repr=False)
@@ -63,6 +67,7 @@ class FrequencyResponse:
     linear: np.ndarray
     point: float
     warnings: list[str] = field(default_factory=list)
+    linear_curve: tuple[np.ndarray, np.ndarray] = field(default=(np.empty(0), np.empty(0)), repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"point": self.point, "points": [
@@ -132,11 +137,31 @@ def from_diagram(scenario: Scenario, d: BifurcationDiagram) -> FrequencyResponse
     if d.points:  # the diagram's own mode count (solver.modes = "auto" chose it on the first value)
         scenario = with_modes_of(scenario, d.points[0].state.result)
     ex = scenario.excitation
-    lin = np.abs(linear_frf(scenario, f)[:, 0]) * abs(ex.scale * ex.amplitude)
+    gain = abs(ex.scale * ex.amplitude)
+    lin = np.abs(linear_frf(scenario, f)[:, 0]) * gain
     return FrequencyResponse(
         diagram=d, frequency=f, direction=np.array([p.direction for p in d.points]),
         max=np.array([p.state.max for p in d.points]), min=np.array([p.state.min for p in d.points]),
         period=np.array([p.state.period for p in d.points]),
         impacts_per_period=np.array([p.state.impacts_per_period for p in d.points]),
         linear=lin, point=strobe_point(scenario), warnings=list(d.warnings),
+        linear_curve=_linear_curve(scenario, f, gain),
     )
+
+
+def _linear_curve(scenario: Scenario, f: np.ndarray, gain: float) -> tuple[np.ndarray, np.ndarray]:
+    """``|H| A`` on 2001 frequencies over the range of ``f``, with its largest value refined to 1e-9 of its frequency."""
+    if not f.size or f.min() == f.max():
+        return f.copy(), np.abs(linear_frf(scenario, f)[:, 0]) * gain if f.size else np.empty(0)
+    from scipy.optimize import minimize_scalar
+
+    grid = np.linspace(f.min(), f.max(), 2001)
+    amp = np.abs(linear_frf(scenario, grid)[:, 0]) * gain
+    k = int(np.argmax(amp))
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    best = minimize_scalar(lambda x: -float(np.abs(linear_frf(scenario, [x])[0, 0])), bounds=(lo, hi),
+                           method="bounded", options={"xatol": 1e-9 * hi})
+    peak = float(best.x)
+    grid = np.insert(grid, int(np.searchsorted(grid, peak)), peak)
+    amp = np.abs(linear_frf(scenario, grid)[:, 0]) * gain
+    return grid, amp

@@ -157,6 +157,8 @@ def plot_frequency_response(fr: Any, path: str | os.PathLike[str] | None = None,
     order = np.argsort(fr.frequency, kind="stable")
     fs = fr.frequency[order]
     lin = fr.linear[order] * scale
+    if len(fr.linear_curve[0]):  # the curve on a fine grid: a resonance between swept values is not missed
+        fs, lin = fr.linear_curve[0], fr.linear_curve[1] * scale
     (l_lin,) = ax.plot(fs, lin, color="#000000", ls="--", lw=0.8, label="linear FRF |H| A (no contact)")
     ax.plot(fs, -lin, color="#000000", ls="--", lw=0.8)
     lines = [l_lin]

@@ -50,6 +50,20 @@ class SweepInterrupted(KeyboardInterrupt):
         self.done = done
         self.total = total
 
+    def summary(self, noun: str, where: str) -> str:
+        """The line a command prints: how many ``noun`` are in ``where`` (none started: nothing was written).
+
+        Parameters
+        ----------
+        noun : str
+            What the runs are (``"cases"``, ``"seeds"``).
+        where : str
+            The store.
+        """
+        if not self.total:
+            return f"interrupted before the first of the {noun} ran: nothing was written"
+        return f"interrupted: {self.done} of {self.total} {noun} are in {where}; run the same command again to finish"
+
 
 @dataclass
 class SweepRun:
