@@ -545,3 +545,43 @@ def test_the_study_recommends_the_count_auto_stops_at():
     assert max(study.estimates[4].values()) < sc.solver.tolerance
     auto = ib.simulate(sc.with_values({"solver.modes": "auto"}))
     assert study.converged_count == auto.n_modes == 8
+
+
+def _overhang(modes) -> ib.Scenario:
+    L, w, h, E, rho = 0.1092, 9.93e-3, 3.03e-3, 1834e6, 951.98
+    k = 1e3 * E * w * h**3 / 12 / L**3
+    return ib.parse_scenario({
+        "beam": {"length": L, "width": w, "height": h, "youngs_modulus": E, "density": rho},
+        "springs": [{"position_ratio": 0.95, "translational": "inf", "rotational": "inf"}],
+        "contactors": [{"position_ratio": 1.0, "stiffness": k, "gap": 0.0, "side": "below"}],
+        "damping": {"free": 0.011, "contact": 0.02},
+        "excitation": {"kind": "point_force", "shape": "step", "amplitude": -1.0, "position": L},
+        "solver": {"modes": modes, "end_time": 0.002}})
+
+
+def test_a_contactor_the_modes_do_not_reach_is_not_converged():
+    """The specimen's cantilever held rigidly (deflection and slope) at 0.95 L, a zero-gap stop k = 1e3 EI/L^3 at
+    the tip of the 0.05 L overhang, a 1 N step there. The overhang's own modes (23 kHz on) lie above the 8th mode
+    of the span (12.8 kHz): with 4, 6 and 8 modes only the stop's attachment shape reaches the tip, so the three
+    runs agree to round-off (estimate 6e-15) while the penetration is 1.4 % off (the finite-element reference of
+    the test suite, 200 elements, gives 2.34016e-6 m, the 96-mode run 2.34016e-6 m). modes = "auto" stopped at 8
+    in silence. Now a run whose modes carry less than 10 % of a contactor's static flexibility is not converged,
+    said so, and auto goes on: 24 modes, 0.09 % off, within the tolerance 2e-3. Case 3's modes carry 99.98 %."""
+    reference = ib.simulate(_overhang(96)).metrics(impacts=False)["max_penetration"]
+    assert reference == pytest.approx(2.34016e-6, rel=1e-5)
+    few = ib.simulate(_overhang(8))
+    assert few.unseen_flexibility is not None and few.unseen_flexibility[1] > 0.999
+    with pytest.warns(ib.ImpactBeamWarning, match=r"static flexibility at contactor 0 lies outside the 8 retained"):
+        few.estimate_convergence()
+    assert max(few.convergence.values()) < 1e-12 and not few.converged
+    assert abs(few.metrics(impacts=False)["max_penetration"] / reference - 1) > 0.01  # what the warning is about
+    auto = ib.simulate(_overhang("auto"))
+    assert auto.n_modes > 8 and auto.converged and auto.unseen_flexibility is None
+    assert abs(auto.metrics(impacts=False)["max_penetration"] / reference - 1) < auto.tolerance
+    assert ib.simulate(ib.load_scenario(EXAMPLES / "case03.toml")).unseen_flexibility is None
+
+
+def test_the_study_does_not_recommend_a_count_whose_modes_miss_a_contactor():
+    study = convergence_study(_overhang(8), [8, 12, 16])
+    assert study.unseen[8] is not None and study.unseen[12] is None
+    assert max(study.estimates[8].values()) < 1e-12 and study.converged_count != 8

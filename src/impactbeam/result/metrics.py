@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
     from ..model.beam import Contactor
 
-__all__ = ["compute_metrics", "contact_forces", "contact_intervals", "response_point", "pushing_parts",
+__all__ = ["compute_metrics", "warn_unresolved", "contact_forces", "contact_intervals", "response_point", "pushing_parts",
            "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
@@ -478,3 +478,34 @@ def _impact_table(result: ResultLike, rows: tuple) -> list[dict[str, Any]]:
         for ci, a, b, peak, imp in zip(rc[order].tolist(), ra[order].tolist(), rb[order].tolist(),
                                        force[order].tolist(), impulse[order].tolist())
     ]
+
+
+def warn_unresolved(result: ResultLike, metrics: dict[str, Any]) -> None:
+    """Warn when the response is too small for the extrema's absolute tolerance (1e-12 of the length).
+
+    Parameters
+    ----------
+    result : SimulationResult
+    metrics : dict
+        Its metrics (:func:`compute_metrics`).
+    """
+    peak = max((abs(v) for v in (metrics.get("max_response"), metrics.get("min_response")) if v is not None),
+               default=0.0)
+    sc = getattr(result, "scenario", None)
+    driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
+    length = result.beam.length
+    if driven and peak < 1e-9 * length and result.contactors:
+        # u may only have moved towards the stop, without reaching it (max_response the start's 0,
+        # min_response undefined): the least u over the run then says how large the response is
+        x, sign = response_point(result.contactors, result.points)
+        sol = result.solution
+        peak = max(peak, float(sol.extrema([(x, 0.0, sol.t_end, -sign, 0.0, None)])[0, 0]))
+    if driven and peak < 1e-9 * length:
+        from .._warnings import emit_user_level_warning
+
+        emit_user_level_warning(
+            f"metrics: the response is only ~{peak:.2g} m, below 1e-9 of the beam length; the extrema behind "
+            f"max_response, t_max and min_response are located to {1e-12 * length:.2g} m "
+            "(1e-12 L), so they are not resolved: scale the load up (the model is linear until contact) or "
+            "read the response from displacement()"
+        )

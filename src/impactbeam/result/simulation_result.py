@@ -115,19 +115,14 @@ class SimulationResult:
     @property
     def warnings(self) -> tuple[str, ...]:
         """The solver's warnings, and the convergence warning once :attr:`convergence` is known."""
-        from ..solver.convergence import NO_ESTIMATE, worst
+        from ..solver.convergence import NO_ESTIMATE, unconverged_message
 
         out = tuple(self.solution.warnings)
         conv = self.__dict__.get("_convergence")
         if conv is None and "_convergence" in self.__dict__:
             out += (NO_ESTIMATE,)
         if conv is not None and not self.converged:
-            key, change = worst(conv)
-            out += (
-                f"not converged in the number of modes: with {self.n_modes} modes the estimated error of {key} is "
-                f"{change:.2g} (relative; solver.tolerance = {self.tolerance:g}); use more modes or "
-                'solver.modes = "auto"',
-            )
+            out += (unconverged_message(self.n_modes, conv, self.tolerance, self.unseen_flexibility),)
         return out
 
     # ------------------------------------------------------------------ convergence in the modes
@@ -202,9 +197,22 @@ class SimulationResult:
 
     @property
     def converged(self) -> bool:
-        """True when every Table-2 metric's estimated error is below ``solver.tolerance``."""
+        """True when every Table-2 metric's estimated error is below ``solver.tolerance``, the estimate seeing
+        every contactor (:attr:`unseen_flexibility` None)."""
         conv = self.convergence
-        return conv is not None and max(conv.values()) < self.tolerance
+        return conv is not None and max(conv.values()) < self.tolerance and self.unseen_flexibility is None
+
+    @property
+    def unseen_flexibility(self) -> tuple[int, float] | None:
+        """A contactor the retained modes do not reach, and the share of its flexibility outside them
+        (:func:`~impactbeam.solver.convergence.unseen_flexibility`); None when they reach every contactor."""
+        if "_unseen" not in self.__dict__:
+            from ..solver.convergence import unseen_flexibility
+
+            sol = self.solution
+            space = sol.packed.space if hasattr(sol, "packed") else getattr(getattr(sol, "ref", None), "space", None)
+            self.__dict__["_unseen"] = None if space is None else unseen_flexibility(space, self.n_modes)
+        return self.__dict__["_unseen"]
 
     @property
     def energy_jumps(self) -> np.ndarray:
@@ -481,10 +489,10 @@ class SimulationResult:
         impacts : bool
             Include the per-impact table (``"impacts"``); sweeps leave it out.
         """
-        from .metrics import compute_metrics
+        from .metrics import compute_metrics, warn_unresolved
 
         out = compute_metrics(self, impacts=impacts)
-        self._warn_unresolved(out)
+        warn_unresolved(self, out)
         if "stress" in self.fields:
             self._require_exact("max_bending_stress")
             from .stress import max_bending_stress
@@ -492,29 +500,6 @@ class SimulationResult:
             value, when, where = max_bending_stress(self)
             out.update(max_bending_stress=value, max_bending_stress_time=when, max_bending_stress_position=where)
         return out
-
-    def _warn_unresolved(self, metrics: dict[str, Any]) -> None:
-        """Warn when the response is too small for the extrema's absolute tolerance (1e-12 of the length)."""
-        peak = max((abs(v) for v in (metrics.get("max_response"), metrics.get("min_response")) if v is not None),
-                   default=0.0)
-        sc = self.scenario
-        driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
-        if driven and peak < 1e-9 * self.beam.length and self.contactors:
-            # u may only have moved towards the stop, without reaching it (max_response the start's 0,
-            # min_response undefined): the least u over the run then says how large the response is
-            from .metrics import response_point
-
-            x, sign = response_point(self.contactors, self.points)
-            peak = max(peak, float(self.solution.extrema([(x, 0.0, self.solution.t_end, -sign, 0.0, None)])[0, 0]))
-        if driven and peak < 1e-9 * self.beam.length:
-            from .._warnings import emit_user_level_warning
-
-            emit_user_level_warning(
-                f"metrics: the response is only ~{peak:.2g} m, below 1e-9 of the beam length; the extrema behind "
-                f"max_response, t_max and min_response are located to {1e-12 * self.beam.length:.2g} m "
-                "(1e-12 L), so they are not resolved: scale the load up (the model is linear until contact) or "
-                "read the response from displacement()"
-            )
 
     @property
     def fields(self) -> tuple[str, ...]:
