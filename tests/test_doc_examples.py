@@ -367,6 +367,12 @@ def _periodic_diagram() -> str:
                 lines.append(f"{p.value:.4g} Hz: {key}")
             prev = key
         at = {(p.direction, p.value): p for p in d.points}
+        for p in d.points:  # where the sweeps disagree: coexisting orbits (hysteresis), or no period on one
+            if p.direction == "up":
+                q = at[("down", p.value)]
+                up, down = ((s.period, round(s.impacts_per_period, 2)) for s in (p.state, q.state))
+                if up != down:
+                    lines.append(f"{p.value:.4g} Hz differs: up {up}, down {down}")
         for f in (55.5, 56.5):
             p = at[("up", f)]
             on = ib.steady_state(sc.with_values({"excitation.frequency": f}), settle_periods=3000,

@@ -57,3 +57,15 @@ def test_bad_input(tmp_path):
     with pytest.raises(ParameterError, match="excitation.amplitude"):
         bifurcation_map(sc, X, ("excitation.amplitude", ["3 mm"]), tmp_path / "m.zarr")
     assert not (tmp_path / "m.zarr").exists()  # nothing written on bad input
+
+
+def test_the_record_lengths_the_maps_page_quotes():
+    # docs/periodic.md: "a map records 20 periods by default, so it shows periods up to 10, where
+    # ib.bifurcation records 50" (a row equals ib.bifurcation's only with the same record)
+    import inspect
+
+    from impactbeam.periodic.bifurcation import bifurcation
+    from impactbeam.periodic.maps import bifurcation_map
+
+    assert inspect.signature(bifurcation_map).parameters["record_periods"].default == 20
+    assert inspect.signature(bifurcation).parameters["record_periods"].default == 50

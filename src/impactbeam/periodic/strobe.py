@@ -358,7 +358,8 @@ def _record_analysis(result: SimulationResult, scenario: Scenario, settle_period
         ipp = n_imp / record_periods
         top = max_period if max_period is not None else record_periods // 2
         why = ("the strobe samples are still converging (a decaying transient)" if settling else
-               "chaotic or quasi-periodic motion, or not settled")
+               "chaotic or quasi-periodic motion, a period longer than the record can show (raise record_periods), "
+               "or not settled")
         warns.append(
             f"no period up to {top} forcing periods within tolerance {tolerance:g} at f = {1 / T:.6g} Hz "
             f"(smallest mismatch {mism:.3g}): {why} after {before} periods; "
