@@ -176,3 +176,23 @@ def test_a_transient_whose_mean_mismatch_starts_within_the_test_is_still_settlin
     assert orbit.converged and orbit.stable
     # tolerance: the period test's 1e-4 of the strobe's scale, what "settled" means
     assert abs(at75.strobe[-1] - orbit.strobe[0]) < 1e-4 * max(abs(at75.max), abs(at75.min))
+
+
+def test_a_strobe_drifting_within_the_test_per_period_has_no_period():
+    """55 Hz, base amplitude swept up from 44.1 m/s^2: at 55.37 m/s^2 the record repeated after 4 periods to
+    within the test from one repetition to the next (mismatch 5.8e-5 < 1e-4) while drifting over the record;
+    500 periods later its lag-4 mismatch is 70 times the test (quasi-periodic: the period-1 orbit there is
+    unstable, |mu| = 1.086 near a quarter turn, and shooting finds no period-4 orbit). It was reported as period
+    4 without a warning. The period now asks every pair of samples a multiple of it apart to agree: no period,
+    warned. The period-4 orbits just below (54.15-55.12 m/s^2) stay: shooting finds each, stable (|mu| 0.76)."""
+    from impactbeam.periodic.bifurcation import bifurcation
+
+    sc = ib.load_scenario(EXAMPLES / "periodic" / "specimen_harmonic.toml").with_values({"excitation.frequency": 55.0})
+    values = list(np.linspace(44.1, 63.7, 81)[:47])
+    with pytest.warns(ib.ImpactBeamWarning, match=r"excitation\.amplitude = 55\.37 \(up\): no period"):
+        d = bifurcation(sc, "excitation.amplitude", values, sweep="up")
+    assert d.points[-1].state.period == 0
+    at = d.points[-3]  # 54.88 m/s^2
+    assert at.state.period == 4
+    orbit = ib.periodic_orbit(sc.with_values({"excitation.amplitude": at.value}), multiple=4, settle_periods=300)
+    assert orbit.converged and orbit.stable

@@ -6,7 +6,10 @@ sampled exactly (closed form, no interpolation) at the strobe times
 ``t_k = start + k T``; the last ``record`` samples form the Poincaré section.
 
 The response period ``n`` (in forcing periods) is the smallest ``n`` with
-``|s_{k+n} - s_k| <= tolerance * scale`` for every recorded sample, where
+``|s_{k+jn} - s_k| <= tolerance * scale`` for every pair of recorded samples
+``n`` apart or a multiple of ``n`` apart (the samples of each phase ``k mod
+n`` lie within the tolerance of each other: a strobe drifting by less than
+the tolerance per period, but more over the record, has not repeated), where
 ``s_k`` is the state sampled at the strobe time: deflection and velocity at
 the contactors, the output points and along the beam, each group scaled by
 its largest magnitude over the record. ``n`` is looked for up to
@@ -127,7 +130,8 @@ def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
     samples : ndarray, (n_samples, n_components)
         Already scaled (each component of order one over the record).
     tolerance : float
-        Largest mismatch ``max_k |s_{k+n} - s_k|`` accepted.
+        Largest mismatch accepted: ``max |s_{k+jn} - s_k|`` over the record, the largest spread of the samples
+        of one phase (module docstring).
     max_period : int, optional
         Largest period tried; default ``(n_samples - 1) // 2``.
 
@@ -143,10 +147,10 @@ def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
     top = (s.shape[0] - 1) // 2 if max_period is None else min(int(max_period), s.shape[0] - 1)
     if top < 1:
         return 0, math.inf
-    mism = float(np.max(np.abs(s[1:] - s[:-1])))  # period 1 alone first: a settled linear response has it
+    mism = _spread(s, 1)  # period 1 alone first: a settled linear response has it
     if mism <= tolerance:
         return 1, mism
-    later = _lag_mismatches(s, top) if top > 1 else np.empty(0)  # the longer periods in one pass, same numbers
+    later = np.array([_spread(s, n) for n in range(2, top + 1)])
     hit = np.flatnonzero(later <= tolerance)
     if hit.size:
         return int(hit[0]) + 2, float(later[hit[0]])
@@ -155,27 +159,23 @@ def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
     return 0, float(np.min(tried)) if tried.size else math.inf
 
 
-def _lag_mismatches(s: np.ndarray, top: int) -> np.ndarray:
-    """``max_k |s_{k+n} - s_k|`` for ``n = 2 .. top`` (``top < len(s)``), from one gather of the sample pairs."""
-    first, second, starts = _lag_pairs(s.shape[0], top)
-    cols = np.ascontiguousarray(s.T)  # components along rows: NumPy reduces long contiguous rows fast
-    d = np.take(cols, second, axis=1)
-    d -= np.take(cols, first, axis=1)
-    np.abs(d, out=d)
-    return np.maximum.reduceat(d, starts, axis=1).max(axis=0)
+def _spread(s: np.ndarray, n: int) -> float:
+    """The largest spread (max - min) of the samples ``s[r::n]`` of one phase ``r`` of period ``n``, any component.
 
-
-@functools.lru_cache(maxsize=32)
-def _lag_pairs(n_samples: int, top: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Indices ``(k, k + n)`` of every pair at lags ``n = 2 .. top``, lag by lag, and where each lag starts."""
-    lags = np.arange(2, top + 1)
-    counts = n_samples - lags
-    first = np.concatenate([np.arange(c) for c in counts])
-    second = first + np.repeat(lags, counts)
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    for a in (first, second, starts):
-        a.flags.writeable = False
-    return first, second, starts
+    Every pair ``s_{k + j n}, s_k`` of the record, not only neighbours: a strobe that drifts by less than the
+    tolerance per period but more over the record has not repeated (NaN when a sample is NaN).
+    """
+    m = s.shape[0] // n
+    if m < 1 or s.shape[0] == n:  # no pair of samples one period apart
+        return math.inf
+    whole = s[: m * n].reshape(m, n, -1)
+    spread = float(np.max(whole.max(axis=0) - whole.min(axis=0)))
+    rest = s[m * n:]
+    if rest.size:  # the last, incomplete repetition
+        tail = float(np.max(np.maximum(whole[:, : rest.shape[0]].max(axis=0), rest)
+                            - np.minimum(whole[:, : rest.shape[0]].min(axis=0), rest)))
+        spread = float(np.max([spread, tail]))  # NaN (a sample after an early stop) kept
+    return spread
 
 
 #: A period above 1 whose shorter-lag mismatches shrink by more than this fraction from the first to the
