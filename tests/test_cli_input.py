@@ -195,3 +195,13 @@ def test_result_file_holds_what_the_command_reported(tmp_path: Path) -> None:
     assert stored["impact_statistics"] == reported["impact_statistics"]
     assert stored["n_impacts"] == reported["n_impacts"] and stored["modes"] == 2
     assert warned == "; ".join(reported["warnings"])
+
+
+def test_a_load_that_never_acts_reports_zero_not_minus_zero(tmp_path: Path) -> None:
+    # max_response was printed "-0.0" in the JSON of a run whose load never acts
+    scenario = tmp_path / "still.toml"
+    text = (EXAMPLES / "case03.toml").read_text(encoding="utf-8")
+    scenario.write_text(text.replace('amplitude = "15 g"', 'amplitude = "0 g"'), encoding="utf-8")
+    proc = run("simulate", scenario, "--json", "--end-time", "0.01")
+    assert proc.returncode == 0, proc.stderr
+    assert '"max_response": 0.0' in proc.stdout and "-0.0" not in proc.stdout

@@ -493,7 +493,8 @@ def test_convergence_command_json_table_and_figure(tmp_path):
     text = runner.invoke(main, ["convergence", case, "--modes", "8,12"])
     assert text.exit_code == 0 and "estimated relative error" in text.stdout and "from 8 modes" in text.stdout
     for bad, field in ((["--modes", "8,x"], "--modes"), (["--max-modes", "500"], "--max-modes"),
-                       (["--modes", "0"], "--modes")):  # the option as typed (the API's argument is counts)
+                       (["--modes", "0"], "--modes"),  # the option as typed (the API's argument is counts)
+                       (["--modes", "4", "--max-modes", "8"], "--max-modes")):  # was ignored, then advised
         r = runner.invoke(main, ["convergence", case, *bad])
         assert r.exit_code == 2 and r.stderr.startswith(f"error: {field}: ") and "Traceback" not in r.output
 

@@ -404,3 +404,13 @@ def test_cli_compare_json_and_plot(tmp_path, case3_truth):
     assert d["rms_difference"] < 1e-6  # the file holds the truth to ~17 digits in mm
     assert abs(d["features"]["first_peak"]["difference_percent"]) < 0.5
     assert png.stat().st_size > 1000
+
+
+def test_a_record_of_the_other_quantity_is_named_with_its_article(tmp_path):
+    # "a acceleration record" (the message of compare's check)
+    from impactbeam.experiment.records import _require
+
+    q = tmp_path / "a.csv"
+    q.write_text("time,acceleration [g]\n" + "\n".join(f"{i * 1e-4},{1.0}" for i in range(10)) + "\n")
+    with pytest.raises(ParameterError, match="a comparison needs a deflection record, got an acceleration record"):
+        _require(ex.load_record(q), "deflection", "a comparison")

@@ -30,12 +30,12 @@ def _counts(text: str | None) -> list[int] | None:
 @click.argument("scenario", metavar="SCENARIO")
 @click.option("--modes", "counts", default=None, metavar="N1,N2,...",
               help="Mode counts to show [default: 4, 6, 8, 12, 16, 24, 32, 48, 64 up to --max-modes].")
-@click.option("--max-modes", "max_modes", type=int, default=64, show_default=True,
-              help="Largest count of the default ladder.")
+@click.option("--max-modes", "max_modes", type=int, default=None,
+              help="Largest count of the default ladder [default: 64; not with --modes].")
 @click.option("--json", "as_json", is_flag=True, help="Print the study as JSON.")
 @click.option("--plot", "plot", default=None, metavar="FILE", help="Save the figure (e.g. .png, .pdf).")
 @handle_errors
-def convergence(scenario: str, counts: str | None, max_modes: int, as_json: bool, plot: str | None) -> None:
+def convergence(scenario: str, counts: str | None, max_modes: int | None, as_json: bool, plot: str | None) -> None:
     """The Table-2 metrics of SCENARIO against the number of modes, with their error estimates.
 
     Every count is run with the counts its estimate compares with (about
@@ -48,6 +48,9 @@ def convergence(scenario: str, counts: str | None, max_modes: int, as_json: bool
 
     check_output("--plot", plot, PLOT_SUFFIXES)
     mode_counts = _counts(counts)  # (the option's value is "counts", as the API's argument: one message rule)
+    if max_modes is not None and counts is not None:
+        raise ParameterError("--max-modes: only for the default ladder; with --modes the counts shown are those given")
+    max_modes = 64 if max_modes is None else max_modes
     if not 4 <= max_modes <= MAX_MODES:
         raise ParameterError(f"--max-modes: expected 4 to {MAX_MODES}, got {max_modes}")
     sc = load_with_overrides(scenario)
@@ -66,12 +69,12 @@ def convergence(scenario: str, counts: str | None, max_modes: int, as_json: bool
     if as_json:
         click.echo(json_text({**study.as_dict(), "warnings": caught}))
     else:
-        click.echo("\n".join([_table(study), *warning_lines(caught)]))
+        click.echo("\n".join([_table(study, "--modes" if counts else "--max-modes"), *warning_lines(caught)]))
     if plot is not None:
         click.echo(f"wrote figure to {plot}", err=True)
 
 
-def _table(study: Any) -> str:
+def _table(study: Any, more: str = "--max-modes") -> str:
     """Values and estimated relative errors, one row per mode count."""
     from ..result.metrics import METRIC_DISPLAY
     from ..solver.convergence import CONVERGENCE_METRICS
@@ -95,7 +98,7 @@ def _table(study: Any) -> str:
     lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in [head, *rows]]
     best = study.converged_count
     lines.append(f"estimate below solver.tolerance = {study.tolerance:g} from {best} modes" if best is not None
-                 else f"no count reaches solver.tolerance = {study.tolerance:g}; use more modes (--max-modes)")
+                 else f"no count reaches solver.tolerance = {study.tolerance:g}; use more modes ({more})")
     return "\n".join(lines)
 
 

@@ -331,7 +331,7 @@ def _value_quantity(
         if quantity is not None and quantity != q:
             raise ScenarioError(
                 f'{label}: {where}: unit "{unit}" is {"a length" if q == "deflection" else "an acceleration"}, '
-                f"but a {quantity} record was expected",
+                f"but {_a(quantity)} record was expected",
                 key="record",
             )
         return scale, q
@@ -437,4 +437,9 @@ def _require_uniform(record: Record, what: str) -> None:
 
 def _require(record: Record, quantity: Quantity, what: str) -> None:
     if record.quantity != quantity:
-        raise ParameterError(f"{record.label}: {what} needs a {quantity} record, got a {record.quantity} record")
+        raise ParameterError(f"{record.label}: {what} needs {_a(quantity)} record, got {_a(record.quantity)} record")
+
+
+def _a(word: str) -> str:
+    """``word`` with its indefinite article (an acceleration, a deflection)."""
+    return f"{'an' if word[:1] in 'aeiou' else 'a'} {word}"

@@ -308,7 +308,7 @@ def metrics_dict(scalars: np.ndarray) -> dict[str, Any]:
     """
     out: dict[str, Any] = {}
     for key, v in zip(METRIC_UNITS, scalars.tolist()):
-        out[key] = None if v != v else (int(v) if key in _COUNTS else v)
+        out[key] = None if v != v else (int(v) if key in _COUNTS else v + 0.0)  # + 0.0: no "-0.0" for a 0
     return out
 
 
