@@ -422,6 +422,13 @@ def test_plot_line_and_heat_map(grid_run, tmp_path):
     assert r.exit_code == 2 and "not one of its values" in r.stderr
     r = runner.invoke(_group(), ["plot", str(out), "--x", "beam.height", "--metric", "max_response"])
     assert r.exit_code == 2 and "not a parameter" in r.stderr
+    # a value with its unit, as every other option takes it ("expected a number" before)
+    r = runner.invoke(_group(), ["plot", str(out), "--x", "excitation.duration", "--metric", "max_response",
+                                 "--sel", "contactors.0.gap=0.229 mm", "--out", str(png)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(_group(), ["plot", str(out), "--x", "excitation.duration", "--metric", "max_response",
+                                 "--sel", "contactors.0.gap=0.229 kg", "--out", str(png)])
+    assert r.exit_code == 2 and "--sel contactors.0.gap" in r.stderr and "a mass" in r.stderr
     # the per-case warnings are text, no metric: refused as such (it was a traceback), and not offered
     r = runner.invoke(_group(), ["plot", str(out), "--x", "excitation.duration", "--metric", "warnings"])
     assert r.exit_code == 2 and "is not in the results" in r.stderr and "Traceback" not in r.output

@@ -53,10 +53,7 @@ def select_cases(ds: Any, keep: Sequence[str], sel: Mapping[str, Any] | None = N
         if dim in sel:
             value = sel[dim]
             if coord.dtype.kind in "fiu":
-                try:
-                    v = float(value)
-                except (TypeError, ValueError):
-                    raise ParameterError(f"--sel {dim}: expected a number, got {value!r}") from None
+                v = _in_si(value, dim, str(ds[dim].attrs.get("units", "")))
                 i = int(np.argmin(np.abs(coord - v)))
                 spacing = float(np.min(np.diff(np.sort(coord)))) if coord.size > 1 else max(abs(v), 1.0)
                 if abs(coord[i] - v) > 1e-6 * spacing:
@@ -167,3 +164,17 @@ def _edges(c: np.ndarray) -> np.ndarray:
         return np.array([c[0] - 0.5, c[0] + 0.5]) if c[0] == 0 else np.array([0.5, 1.5]) * c[0]
     mid = 0.5 * (c[1:] + c[:-1])
     return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+
+
+def _in_si(value: Any, dim: str, unit: str) -> float:
+    """A ``--sel`` value as a number in the coordinate's SI ``unit``: a number, or a string with a unit."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        pass
+    from ..units import DIMENSIONS, to_si
+
+    dimension = next((name for name, d in DIMENSIONS.items() if unit and d.si_unit == unit), None)
+    if dimension is None or not isinstance(value, str):
+        raise ParameterError(f"--sel {dim}: expected a number{f' [{unit}]' if unit else ''}, got {value!r}")
+    return to_si(value, dimension, f"--sel {dim}")
