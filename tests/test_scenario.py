@@ -366,10 +366,21 @@ def test_set_path_alternatives_and_presets() -> None:
     assert new["supports"]["left"] == {"translational": math.inf}
 
 
+def test_a_shortened_key_is_completed_where_keys_are_read_alone() -> None:
+    # a sweep's or a bifurcation's parameter is checked against the whole schema: "excitation.freq" was
+    # answered with "excitation.file", the closest by letters
+    from impactbeam.scenario import path_dimension
+
+    with pytest.raises(ScenarioError, match=r'did you mean "excitation\.frequency"'):
+        path_dimension("excitation.freq")
+
+
 @pytest.mark.parametrize(
     ("path", "match"),
     [
         ("beam.lenght", r'unknown key "beam.lenght" \(did you mean "beam.length"\?\)'),
+        # a shortened key: the key it begins, not the closest by letters ("excitation.file")
+        ("excitation.freq", r'unknown key "excitation.freq" \(did you mean "excitation.frequency"\?\)'),
         ("contactors.3.gap", "out of range"),
         ("contactors.x.gap", "not an index"),
         ("beam.length.0", "single value"),

@@ -169,8 +169,9 @@ def _join(prefix: str, key: str | int) -> str:
 
 
 def _suggest(path: str, siblings: list[str], everything: list[str]) -> str:
-    """`` (did you mean "x"?)`` or a list of the valid keys at that level."""
-    match = difflib.get_close_matches(path, siblings, n=1, cutoff=0.6)
+    """`` (did you mean "x"?)`` or a list of the valid keys at that level (a key the typed one begins first)."""
+    match = [s for s in (siblings or everything) if s.startswith(path)][:1]  # a shortened key: excitation.freq
+    match = match or difflib.get_close_matches(path, siblings, n=1, cutoff=0.6)
     if not match:
         match = difflib.get_close_matches(path, everything, n=1, cutoff=0.75)
     if match:
