@@ -49,6 +49,13 @@ WARNED = [
     # the example unit is the key's (a stress was shown as "800 mm")
     pytest.param(BEAM.replace('youngs_modulus = 1834e6', 'youngs_modulus = "1834e6"') + SHORT + PULSE,
                  'or with its unit (e.g. "1834e6 Pa")', id="numeric-string-stress"),
+    # an S-N curve whose reference point does no damage, a Goodman line below it (units left out, typically)
+    pytest.param(BEAM + SHORT + PULSE + '[fatigue]\npoints = [0.0]\nsn_stress = "800 MPa"\nsn_cycles = 1e6\n'
+                 'sn_exponent = 4\nendurance_limit = "900 MPa"\n',
+                 "fatigue.endurance_limit: 9e+08 Pa is at or above sn_stress = 8e+08 Pa", id="endurance-above-sn"),
+    pytest.param(BEAM + SHORT + PULSE + '[fatigue]\npoints = [0.0]\nsn_stress = "800 MPa"\nsn_cycles = 1e6\n'
+                 'sn_exponent = 4\nmean_stress = "goodman"\nultimate_strength = "500 MPa"\n',
+                 "fatigue.ultimate_strength: 5e+08 Pa is at or below sn_stress = 8e+08 Pa", id="ultimate-below-sn"),
     pytest.param(BEAM + PULSE + SHORT + "event_tolerance = 1e-6\n",
                  "solver.event_tolerance: 1e-06 s is more than 1e-3 of solver.time_step", id="event-tolerance"),
 ]

@@ -240,7 +240,9 @@ def warn_unusual(sc: Scenario) -> None:
 
     * ``initial.modal_displacement`` / ``modal_velocity`` with more entries
       than ``solver.modes``: the extra entries are ignored by the solver;
-    * an excitation that starts at or after ``solver.end_time``: it never acts.
+    * an excitation that starts at or after ``solver.end_time``: it never acts;
+    * an endurance limit at or above the S-N curve's reference stress, an
+      ultimate strength at or below it (``[fatigue]``).
 
     (A contactor at a support that holds ``w = 0`` is refused, not warned
     about: :meth:`~impactbeam.model.beam.Contactor.check_on`.)
@@ -262,4 +264,15 @@ def warn_unusual(sc: Scenario) -> None:
                 f"{key}: the excitation starts at {first:g} s, at or after solver.end_time = "
                 f"{sc.solver.end_time:g} s; it never acts in this run"
             )
+    fat = sc.fatigue
+    if fat is not None and fat.endurance_limit >= fat.sn_stress:
+        emit_user_level_warning(
+            f"fatigue.endurance_limit: {fat.endurance_limit:g} Pa is at or above sn_stress = {fat.sn_stress:g} Pa, "
+            "so the S-N curve's own reference point does no damage; check the two values and their units"
+        )
+    if fat is not None and fat.ultimate_strength is not None and fat.ultimate_strength <= fat.sn_stress:
+        emit_user_level_warning(
+            f"fatigue.ultimate_strength: {fat.ultimate_strength:g} Pa is at or below sn_stress = {fat.sn_stress:g} "
+            "Pa, a fatigue amplitude the material would not survive once; check the two values and their units"
+        )
 
