@@ -147,10 +147,10 @@ def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
     top = (s.shape[0] - 1) // 2 if max_period is None else min(int(max_period), s.shape[0] - 1)
     if top < 1:
         return 0, math.inf
-    mism = _spread(s, 1)  # period 1 alone first: a settled linear response has it
+    mism = _spread_one(s)  # period 1 alone first: a settled linear response has it
     if mism <= tolerance:
         return 1, mism
-    later = np.array([_spread(s, n) for n in range(2, top + 1)])
+    later = _spreads(s, top) if top > 1 else np.empty(0)  # the longer periods in one pass, the same numbers
     hit = np.flatnonzero(later <= tolerance)
     if hit.size:
         return int(hit[0]) + 2, float(later[hit[0]])
@@ -159,23 +159,41 @@ def detect_period(samples: np.ndarray, tolerance: float = PERIOD_TOLERANCE,
     return 0, float(np.min(tried)) if tried.size else math.inf
 
 
-def _spread(s: np.ndarray, n: int) -> float:
-    """The largest spread (max - min) of the samples ``s[r::n]`` of one phase ``r`` of period ``n``, any component.
+def _spreads(s: np.ndarray, top: int) -> np.ndarray:
+    """The mismatch of each period ``n = 2 .. top`` (``top < len(s)``): the largest spread of the samples of one
+    phase ``r`` (``s[r::n]``), any component, from one gather of the samples phase by phase (NaN kept)."""
+    order, classes, periods = _phase_classes(s.shape[0], top)
+    cols = np.ascontiguousarray(s.T)[:, order]  # components along rows: NumPy reduces long contiguous rows fast
+    spread = (np.maximum.reduceat(cols, classes, axis=1) - np.minimum.reduceat(cols, classes, axis=1)).max(axis=0)
+    return np.maximum.reduceat(spread, periods)
 
-    Every pair ``s_{k + j n}, s_k`` of the record, not only neighbours: a strobe that drifts by less than the
-    tolerance per period but more over the record has not repeated (NaN when a sample is NaN).
+
+@functools.lru_cache(maxsize=32)
+def _phase_classes(n_samples: int, top: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sample indices of each phase ``r`` of each period ``n = 2 .. top`` in turn, where each phase's and
+    each period's indices start."""
+    order, classes, periods = [], [], []
+    at = 0
+    for n in range(2, top + 1):
+        periods.append(len(classes))
+        for r in range(n):
+            idx = np.arange(r, n_samples, n)
+            classes.append(at)
+            order.append(idx)
+            at += idx.size
+    out = (np.concatenate(order), np.array(classes), np.array(periods))
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
+def _spread_one(s: np.ndarray) -> float:
+    """The mismatch of period 1: the largest spread (max - min) of the record, any component (NaN kept).
+
+    Every pair of samples, not only neighbours: a strobe that drifts by less than the tolerance per period but
+    more over the record has not repeated.
     """
-    m = s.shape[0] // n
-    if m < 1 or s.shape[0] == n:  # no pair of samples one period apart
-        return math.inf
-    whole = s[: m * n].reshape(m, n, -1)
-    spread = float(np.max(whole.max(axis=0) - whole.min(axis=0)))
-    rest = s[m * n:]
-    if rest.size:  # the last, incomplete repetition
-        tail = float(np.max(np.maximum(whole[:, : rest.shape[0]].max(axis=0), rest)
-                            - np.minimum(whole[:, : rest.shape[0]].min(axis=0), rest)))
-        spread = float(np.max([spread, tail]))  # NaN (a sample after an early stop) kept
-    return spread
+    return float(np.max(s.max(axis=0) - s.min(axis=0)))
 
 
 #: A period above 1 whose shorter-lag mismatches shrink by more than this fraction from the first to the
