@@ -21,7 +21,8 @@ __all__ = ["modes"]
               help="Number of modes per state [default: the scenario's solver.modes].")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
 @click.option("--plot", "plot_path", default=None, metavar="FILE.png",
-              help="Draw the free-state mode shapes with steps, springs, masses and contactors marked.")
+              help="Draw the first six (at most) free-state mode shapes with steps, springs, masses and "
+                   "contactors marked.")
 @handle_errors
 def modes(scenario: str, count: int | None, as_json: bool, plot_path: str | None = None) -> None:
     """Natural frequencies of the free and the contact state.
