@@ -29,8 +29,8 @@ def modes(scenario: str, count: int | None, as_json: bool, plot_path: str | None
 
     The contact state has every contactor engaged; it is omitted without
     contactors. Section steps, point masses and permanent springs
-    (``[[beam.sections]]``, ``[[masses]]``, ``[[springs]]``) belong to both
-    states; the JSON then has a ``structure`` entry listing them.
+    ([[beam.sections]], [[masses]], [[springs]]) belong to both states; the
+    JSON then has a "structure" entry listing them.
     """
     from ..model.options import MAX_MODES
 
