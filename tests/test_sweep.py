@@ -621,3 +621,14 @@ def test_an_interrupt_before_the_first_case_says_nothing_was_written():
     later = SweepInterrupted(signal.SIGTERM, 3, 36)
     assert later.summary("seeds", "rnd") == ("interrupted: 3 of 36 seeds are in rnd; run the same command again to "
                                              "finish")
+
+
+@pytest.mark.dask
+def test_a_scheduler_out_of_reach_leaves_no_store(tmp_path):
+    """Exit 2 naming --scheduler, and no store: one was left with every case "not yet run" (after 10 s)."""
+    path = _write(tmp_path, "far.toml", KILL)
+    out = tmp_path / "far.zarr"
+    proc = subprocess.run([*_cli(), "sweep", str(path), "--out", str(out), "--scheduler", "tcp://127.0.0.1:9",
+                           "--no-progress"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and proc.stderr.startswith("error: --scheduler: cannot connect"), proc.stderr
+    assert not out.exists()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import os
+import shutil
 import signal
 import threading
 from functools import partial
@@ -272,6 +273,7 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
     fresh = not (out_path is not None and out_path.exists()
                  and not (out_path.is_dir() and not any(out_path.iterdir())))
     local = maker = None
+    unused = False  # a new store that an error left without a case: removed
     counts = {"computed": 0, "failed": 0}
     bar = writer = None
     try:
@@ -324,6 +326,9 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
                     exc.done = spec.n_cases - n_todo + counts["computed"]
                     exc.total = spec.n_cases
                     raise
+                except Exception:  # an error before any case was stored (a scheduler out of reach): no store left
+                    unused = fresh and out_path is not None and not counts["computed"]
+                    raise
     finally:
         if maker is not None:
             maker.close()
@@ -333,6 +338,8 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
             bar.close()
         if writer is not None:
             writer.close()
+        if unused:
+            shutil.rmtree(out_path, ignore_errors=True)  # type: ignore[arg-type]
     log.info("sweep %s: %d cases, %d computed, %d already done, %d failed",
              spec.name, spec.n_cases, counts["computed"], skipped, counts["failed"])
     if out_path is not None and not fresh:  # a store made before metadata was consolidated at creation
