@@ -5,8 +5,8 @@ The moment of the N-mode solution is the modal sum ``M = sum_j eta_j EI psi_j''`
 the modes than deflection near loads and stops, so by default the
 mode-acceleration method is used (Williams 1945; Craig & Kurdila, *Fundamentals
 of Structural Dynamics*, section 14.5): with every load written as an external
-force on the free state (supports only) -- the excitation ``p(x) u(t)`` and
-the contact forces ``f_c(t)`` at the contactors,
+force on the free state (supports only) -- the excitation ``p(x) u(t)``, the
+constant ``[preload]`` and the contact forces ``f_c(t)`` at the contactors,
 
 .. math:: M(x, t) = M_{st}(x, t) + \\sum_j \\Big(\\eta_j(t) - \\frac{Q_j(t)}{\\lambda_j}\\Big) EI\\,\\psi_j''(x),
           \\qquad Q_j = p_j u(t) + \\sum_c f_c(t)\\,\\psi_j(a_c),
@@ -135,6 +135,10 @@ def _static_part(result: Any, space: Any, free: Any, x: np.ndarray, t: np.ndarra
     u = np.asarray(excitation.history(t), dtype=float) if excitation.kind != "none" else np.zeros(t.size)
     Q = u[:, None] * np.asarray(free.load_weights, dtype=float)[None, :]
     out = u[:, None] * _excitation_static(beam, excitation, x)[None, :]
+    if space.preload is not None:  # the constant [preload]: its modal force and its static moment, at every time
+        held = space.preload.excitation()  # as a step from t = 0 (Preload.excitation: its one reading as a load)
+        Q += np.asarray(free.preload_weights, dtype=float)[None, :]
+        out += float(held.scale * held.amplitude) * _excitation_static(beam, held, x)[None, :]
     for i, c in enumerate(result.contactors):
         compression = c.direction * smp.w[:, i] - c.gap
         f = np.where(smp.engaged[:, i], -c.direction * c.stiffness * compression, 0.0)  # force on the beam, along +w
