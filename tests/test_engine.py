@@ -344,3 +344,12 @@ def test_a_dashpot_release_that_chatters_stops_both_paths():
     # the chatter is at the release: both paths spend their 400 events within a microsecond after it
     # (measured 0.32 us for the engine, 0.16 us for solve_ivp)
     assert release < ex.solution.t_end < release + 1e-6 and release < iv.solution.t_end < release + 1e-6
+
+
+def test_a_projection_without_effect_is_said():
+    # solver.projection = "contact" with the shared enriched basis changed nothing (w identical to the bit),
+    # in silence, where every other key without effect is refused or warned about
+    args = with_options(with_contactor(problem(), stiffness=64000.0), projection="contact", end_time=0.01)
+    with pytest.warns(ib.ImpactBeamWarning, match=r'solver\.projection = "contact" has no effect'):
+        shared = run(args)
+    assert np.array_equal(shared.w, run(with_options(args, projection="paper")).w)

@@ -60,6 +60,13 @@ def make_space(beam, contactors, damping, excitation, options: SolverOptions, po
     if options.basis == "enriched" and (beam.is_uniform or not mode_set(beam, (), options.modes).n_rigid):
         from .ritz_space import RitzStateSpace
 
+        if options.projection != "paper" and contactors:
+            from .._warnings import emit_user_level_warning
+
+            emit_user_level_warning(
+                f'solver.projection = "{options.projection}" has no effect: the enriched basis is shared by every '
+                'contact state, so a switch projects nothing (it applies with solver.basis = "paper")'
+            )
         return RitzStateSpace(beam, contactors, damping, excitation, options.modes, points, preload)  # type: ignore[return-value]
     if options.basis == "enriched" and contactors:
         from .._warnings import emit_user_level_warning
