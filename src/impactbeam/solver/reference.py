@@ -208,10 +208,11 @@ class _Reference:
         return evs, rows
 
     def _judge_start(self, evs: list, rows: list, t: float, y0: np.ndarray, rhs, just: int | None,
-                     judged: dict[int, int]) -> tuple[list[int], list[int], list[int]]:
+                     judged: dict[int, int], t_stop: float) -> tuple[list[int], list[int], list[int]]:
         """Rows on the wrong side at a restart: to switch at once, where they turn back, or let run from below 0.
 
-        The last are within the touch tolerance below 0; they count once deeper than it (:meth:`_shifted`).
+        The last are within the touch tolerance below 0 (or at 0, the beam still under no load until
+        ``t_stop``); they count once deeper than it (:meth:`_shifted`).
 
         The engine's rule (:mod:`~impactbeam.solver._loop`): a row below
         ``-1e-12 L`` switches at once, unless it belongs to the contactor just
@@ -221,6 +222,8 @@ class _Reference:
         ``1e-12 L`` of 0 (touching) switches at once when its slope points to the wrong side.
         """
         tol = self.tol
+        # at rest in equilibrium under a load that is 0 over the whole piece: every row stays where it is
+        still = all(not np.any(rhs(tt, y0)) for tt in (t, t + (t_stop - t) / 3.0, t + 2.0 * (t_stop - t) / 3.0))
         wrong, turns, below = [], [], []
         for r, ev in enumerate(evs):
             h = ev(t, y0)
@@ -230,8 +233,8 @@ class _Reference:
             if h >= -tol:  # touching (a zero gap at a crossing, a contactor just switched): its slope decides
                 if slope < 0.0 and judged.get(rows[r][0], 0) < 2:
                     wrong.append(r)
-                elif h < 0.0:
-                    below.append(r)
+                elif h < 0.0 or (h == 0.0 and still):
+                    below.append(r)  # (at 0 and still too: solve_ivp takes a row that stays at 0 for a crossing)
                 continue
             back = rows[r][0] == just and rows[r][1] == "main" and slope >= 0.0
             if not back and judged.get(rows[r][0], 0) < 2:
@@ -357,7 +360,7 @@ class _Reference:
                 atol_state[engaged] = self.atol(st, y0)
             if t != judged_t:
                 judged, judged_t = {}, t
-            wrong, turns, below = self._judge_start(evs, rows, t, y0, rhs, just, judged)
+            wrong, turns, below = self._judge_start(evs, rows, t, y0, rhs, just, judged, t_stop)
             if wrong and rows[wrong[0]][1] == "phase":
                 phase[rows[wrong[0]][0]] = False  # the penetration left by a release is gone: a plain opening
                 continue
