@@ -168,9 +168,11 @@ _SDNL104_RUNS = (
     ("5 modes, paper basis", 5, "paper", 8e-2, 4e-2, "code_aster PRECISION of its 5-mode run (sdnl104c TRAN4)", True),
     ("5 modes, enriched basis", 5, "enriched", None, None, "informative: the shared basis at 5 modes", False),
     ("8 modes, enriched basis", 8, "enriched", None, None, "informative: the shared basis at 8 modes", False),
-    ("converged (40 modes), paper basis", 40, "paper", 2e-2, 4e-2,
+    # converged: the tip velocity at 0.1566 s converges slowly in the modes (40 modes of the shared basis were
+    # 0.85 % from 120 modes, their Table-2 estimate converged all the same); 80 and 120 modes agree to 0.06 %
+    ("converged (120 modes), paper basis", 120, "paper", 2e-2, 4e-2,
      "code_aster PRECISION with a static mode (2 %); 4 % on the velocity (the reference's own error)", True),
-    ("converged (40 modes), enriched basis", 40, "enriched", 2e-2, 4e-2,
+    ("converged (120 modes), enriched basis", 120, "enriched", 2e-2, 4e-2,
      "code_aster PRECISION with a static mode (2 %); 4 % on the velocity (the reference's own error)", True),
 )
 

@@ -41,7 +41,7 @@ SOURCES: dict[str, Source] = {
     "SDLX400": Source(
         "SDLX400",
         "code_aster validation test SDLX400 (validation manual V2.05.400), test file sdlx400a.comm "
-        f"(POU_D_E, lines 95-135 free, 275-330 with the spring; {CODE_ASTER_SNAPSHOT}); REFERENCE='ANALYTIQUE'",
+        f"(POU_D_E, lines 96-137 free, 276-325 with the spring; {CODE_ASTER_SNAPSHOT}); REFERENCE='ANALYTIQUE'",
         "analytical",
     ),
     "SDNL32": Source(
