@@ -131,6 +131,7 @@ def _document(rep: ReproductionReport, data: dict[str, Any]) -> _Doc:
         _doc_parameter_study,
         _doc_refit,
         _doc_summary,
+        _doc_warnings,
     ):
         section(doc, rep, data)
     return doc
@@ -364,6 +365,18 @@ def _doc_summary(doc: _Doc, rep: ReproductionReport, data: dict[str, Any]) -> No
           "half-sine pulses.")
     doc.table(["Topic", "Statement", "Verdict"], [[f.topic, f.statement, f.verdict] for f in allf])
 
+
+
+def _doc_warnings(doc: _Doc, rep: ReproductionReport, data: dict[str, Any]) -> None:
+    """The report's section: the warnings of the runs (a statement resting on one of those runs is not settled)."""
+    doc.h(2, "Warnings of the runs")
+    if not rep.warnings:
+        doc.p("The solver warned of none of the runs.")
+        return
+    doc.p("The paper's own method (each state's modes, the counts above) is run as the paper ran it; the solver "
+          "says where it does not trust a run, and a statement above that rests on such a run is not settled by "
+          "it (the convergence section shows what more modes change):")
+    doc.ul(f"`{text}`" if "`" not in text else text for text in rep.warnings)
 
 
 def write_readme_section(report: ReproductionReport, docs_dir: str | os.PathLike[str],

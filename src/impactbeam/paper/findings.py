@@ -79,6 +79,8 @@ class ReproductionReport:
         Per contact case, the direction of the first excursion (away from the contactor first?).
     settings : dict
         The settings of the study (modes, output step, durations).
+    warnings : list of str
+        The runs' warnings, each labelled with its run (a run the solver does not trust: its findings with it).
     """
 
     out_dir: Path
@@ -100,6 +102,7 @@ class ReproductionReport:
     n_simulations: int = 0
     elapsed: float = 0.0
     settings: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
 
     def all_findings(self) -> list[Finding]:
         """Section 3, convergence and parameter-study findings together."""

@@ -59,6 +59,7 @@ class _Runner:
         self._cache: dict[str, Any] = {}
         self._progress = progress
         self.count = 0
+        self.warnings: list[str] = []  # each run's, labelled with the run (the report lists them)
 
     @staticmethod
     def key(sc: Scenario) -> str:
@@ -76,7 +77,8 @@ class _Runner:
             with WarningLog() as log:  # said again with the run they belong to
                 res = simulate(sc)
             for text in log.messages:
-                emit_user_level_warning(f"{label or sc.name}: {text}")
+                self.warnings.append(f"{label or sc.name}: {text}")
+                emit_user_level_warning(self.warnings[-1])
             if not res.success:
                 raise SimulationError(f"{label or sc.name}: {res.message}")
             self._cache[k] = res
@@ -166,6 +168,7 @@ def reproduce(out_dir: str | os.PathLike[str], *, progress: bool = True) -> Repr
     finally:
         bar.close()
     report = _assemble(data, out, figures, runner.count, time.perf_counter() - t_start)
+    report.warnings = list(runner.warnings)
     doc = _document(report, data)
     write_text(report.report_md, doc.markdown())
     write_text(report.report_html, doc.html("impactbeam: reproduction of Xu & Ervin (2013)"))
