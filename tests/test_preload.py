@@ -317,3 +317,33 @@ def test_the_bending_moment_holds_the_preload(stop):
     stress = res.metrics(impacts=False)["max_bending_stress"]
     peak = np.abs(exact(np.linspace(0.0, L, 200001))).max()  # at the clamp or at the stop's kink
     assert stress == pytest.approx(peak * 6 / (b * h * h), rel=1e-9)
+
+
+@pytest.mark.parametrize("law", [{"damping": 200.0}, {"restitution": 0.3}])
+def test_the_bending_moment_holds_a_dashpots_force(law):
+    """The specimen pressed onto a zero-gap stop at 0.484 L by a 0.05 N tip preload (equilibrium), then moved
+    slowly by a 5 Hz tip force: the stop stays engaged, its force k d + c d'. The static correction took k d
+    alone: with the paper's basis (8 modes) the moment at the stop was 1.4 % off (the dashpot of 200 N s/m; 0.15 %
+    with restitution 0.3), halving only with twice the modes. The enriched basis, which agrees with a finite-
+    element model to 3e-5, is the reference here (24 modes); measured now 3.3e-5 at the stop (tolerance 2e-4) and
+    5.7e-4 at the clamp, the paper basis's own truncation there (tolerance 1e-3; it was 5.6e-3)."""
+    L, a = 0.1092, 0.484 * 0.1092
+    times = np.linspace(0.1, 0.2, 201)
+
+    def moments(basis, modes):
+        sc = ib.parse_scenario({
+            "beam": {"length": L, "width": 9.93e-3, "height": 3.03e-3, "youngs_modulus": 1834e6, "density": 951.98},
+            "contactors": [{"position": a, "stiffness": 4030.0, "gap": 0.0, "side": "below", **law}],
+            "preload": {"kind": "point_force", "amplitude": -0.05, "position": L}, "initial": {"equilibrium": True},
+            "excitation": {"kind": "point_force", "shape": "harmonic", "frequency": 5.0, "amplitude": 0.02,
+                           "position": L},
+            "damping": {"free": 0.02, "contact": 0.02},
+            "solver": {"modes": modes, "time_step": 1e-4, "end_time": 0.2, "basis": basis}})
+        res = ib.simulate(sc)
+        assert len(res.events) == 1  # engaged from t = 0 to the end: a linear system
+        return res.bending_moment([0.0, a], times)
+
+    reference = moments("enriched", 24)
+    paper = moments("paper", 8)
+    clamp, stop = np.abs(paper - reference).max(axis=1) / np.abs(reference).max(axis=1)
+    assert stop <= 2e-4 and clamp <= 1e-3

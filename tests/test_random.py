@@ -160,7 +160,7 @@ BAD_FATIGUE = [
     ('points = [0.0]\nsn_stress = "20 MPa"\nsn_exponent = 8', "fatigue.sn_cycles", "required"),
     # pint's cycle is a turn, 2 pi rad: "1e6 cycles" was a count of 6.28e6
     ('points = [0.0]\nsn_stress = "20 MPa"\nsn_cycles = "1e6 cycles"\nsn_exponent = 8', "fatigue.sn_cycles",
-     "has an angle in its unit"),
+     "has an angle in its unit, expected a dimensionless number (a count of cycles is a plain number: 1e6)"),
 ]
 
 _HEAD = """

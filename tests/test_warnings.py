@@ -56,6 +56,10 @@ WARNED = [
     pytest.param(BEAM + SHORT + PULSE + '[fatigue]\npoints = [0.0]\nsn_stress = "800 MPa"\nsn_cycles = 1e6\n'
                  'sn_exponent = 4\nmean_stress = "goodman"\nultimate_strength = "500 MPa"\n',
                  "fatigue.ultimate_strength: 5e+08 Pa is at or below sn_stress = 8e+08 Pa", id="ultimate-below-sn"),
+    pytest.param(BEAM + SHORT + PULSE + '[fatigue]\npoints = [0.0]\nsn_stress = 800\nsn_cycles = 1e6\n'
+                 'sn_exponent = 4\n',
+                 'fatigue.sn_stress: 800 Pa is below 1e-6 of the beam\'s Young\'s modulus (1.834e+09 Pa); a plain '
+                 'number is in Pa: give the unit ("800 MPa")', id="sn-stress-bare-number"),
     pytest.param(BEAM + PULSE + SHORT + "event_tolerance = 1e-6\n",
                  "solver.event_tolerance: 1e-06 s is more than 1e-3 of solver.time_step", id="event-tolerance"),
 ]

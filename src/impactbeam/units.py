@@ -235,7 +235,8 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
     if wanted:
         hint = "; give it in rad/s, deg/s, rpm or Hz (revolutions)" if dimension == "angular_velocity" else ""
         raise _UnitProblem(f'"{text}" has no angle in its unit, expected {describe_dimension(dimension)}{hint}')
-    raise _UnitProblem(f'"{text}" has an angle in its unit, expected {describe_dimension(dimension)}')
+    hint = " (a count of cycles is a plain number: 1e6)" if dimension == "dimensionless" and "cycle" in text else ""
+    raise _UnitProblem(f'"{text}" has an angle in its unit, expected {describe_dimension(dimension)}{hint}')
 
 
 def _root_powers(quantity: Any) -> tuple[dict[str, float], float, float]:

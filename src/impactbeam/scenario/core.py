@@ -242,7 +242,8 @@ def warn_unusual(sc: Scenario) -> None:
       than ``solver.modes``: the extra entries are ignored by the solver;
     * an excitation that starts at or after ``solver.end_time``: it never acts;
     * an endurance limit at or above the S-N curve's reference stress, an
-      ultimate strength at or below it (``[fatigue]``).
+      ultimate strength at or below it, a fatigue stress below 1e-6 of the
+      Young's modulus (a bare number meant as MPa) (``[fatigue]``).
 
     (A contactor at a support that holds ``w = 0`` is refused, not warned
     about: :meth:`~impactbeam.model.beam.Contactor.check_on`.)
@@ -265,6 +266,15 @@ def warn_unusual(sc: Scenario) -> None:
                 f"{sc.solver.end_time:g} s; it never acts in this run"
             )
     fat = sc.fatigue
+    if fat is not None:  # a stress given as a bare number is in Pa: "800" meant as MPa is a million times small
+        modulus = min(p.youngs_modulus for p in sc.beam.pieces())
+        for name in ("sn_stress", "endurance_limit", "ultimate_strength"):
+            value = getattr(fat, name)
+            if value is not None and 0.0 < value < 1e-6 * modulus:
+                emit_user_level_warning(
+                    f"fatigue.{name}: {value:g} Pa is below 1e-6 of the beam's Young's modulus ({modulus:g} Pa); "
+                    f'a plain number is in Pa: give the unit ("{value:g} MPa")'
+                )
     if fat is not None and fat.endurance_limit >= fat.sn_stress:
         emit_user_level_warning(
             f"fatigue.endurance_limit: {fat.endurance_limit:g} Pa is at or above sn_stress = {fat.sn_stress:g} Pa, "
