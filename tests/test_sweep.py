@@ -610,6 +610,14 @@ def test_a_changed_trace_file_is_another_sweep(tmp_path):
     (tmp_path / "pulse.csv").write_text("t,a\n0,0\n0.005,300\n0.01,0\n")
     with pytest.raises(ParameterError, match="holds the results of a different sweep"):
         run_sweep(path, tmp_path / "s.zarr", workers=0, progress=False)
+    # a trace named as a swept value: its numbers too (a store mixed the old and the new file's cases)
+    (tmp_path / "other.csv").write_text("t,a\n0,0\n0.005,50\n0.01,0\n")
+    swept = _write(tmp_path, "f.toml", 'base = "b.toml"\n[parameters."excitation.file"]\n'
+                   'values = ["pulse.csv", "other.csv"]\n[outputs]\nmetrics = ["max_response"]\n')
+    run_sweep(swept, tmp_path / "f.zarr", workers=0, progress=False)
+    (tmp_path / "other.csv").write_text("t,a\n0,0\n0.005,25\n0.01,0\n")
+    with pytest.raises(ParameterError, match="holds the results of a different sweep"):
+        run_sweep(swept, tmp_path / "f.zarr", workers=0, progress=False)
 
 
 def test_an_interrupt_before_the_first_case_says_nothing_was_written():

@@ -268,6 +268,7 @@ class SweepSpec:
             "format": _FORMAT_VERSION,
             "base": self.base.data,
             "samples_read": _read_samples_digest(self.base),
+            "swept_files_read": self._swept_files_digest(),
             "design": self.design,
             "parameters": params,
             "metrics": list(self.metrics),
@@ -279,6 +280,15 @@ class SweepSpec:
             out["histories"] = {"points": list(self.histories.points), "time_step": self.histories.time_step}
         if self.statistics:
             out["statistics"] = True
+        return out
+
+    def _swept_files_digest(self) -> dict[str, list[str]]:
+        """:func:`_read_samples_digest` of the base with each value of a parameter naming a file (a swept trace):
+        a file changed after a store was made is another sweep, as a changed base file is."""
+        out: dict[str, list[str]] = {}
+        for p in self.parameters:
+            if p.values is not None and p.path.rsplit(".", 1)[-1].endswith("file"):
+                out[p.path] = [_read_samples_digest(self.base.with_values({p.path: v})) for v in p.values]
         return out
 
     @property
