@@ -302,6 +302,12 @@ def test_sweep_over_gap_and_level_stores_the_statistics():
     assert got == alone["rate"]
     rates = ds["impact_rate"].values[..., 0]
     assert rates[0, 1] > rates[1, 1] and rates[1, 1] > rates[1, 0]  # closer or harder: more impacts
+    # the statistics' count of impacts begun in the window is its own variable: it had replaced the Table-2
+    # n_impacts (every impact of the run) under the same name
+    at = {"contactors.0.gap": 0.6e-3, "excitation.scale": 2.0}
+    assert int(ds["n_impacts"].sel(at).values) == ib.simulate(case).metrics(impacts=False)["n_impacts"]
+    assert int(ds["window_impacts"].sel(at).values[0]) == alone["n_impacts"]
+    assert ds["n_impacts"].dims == ("contactors.0.gap", "excitation.scale")
 
 
 def test_random_figures(tmp_path):

@@ -640,3 +640,14 @@ def test_a_scheduler_out_of_reach_leaves_no_store(tmp_path):
                            "--no-progress"], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and proc.stderr.startswith("error: --scheduler: cannot connect"), proc.stderr
     assert not out.exists()
+
+
+def test_a_rigid_stop_swept_is_a_failed_case_not_a_traceback(tmp_path):
+    # "inf" (a rigid stop: modes only, simulate refuses it) as a swept stiffness ended in a traceback from the
+    # sweep's hash (JSON has no infinity); it is now a case that fails with its message, the others run
+    path = _write(tmp_path, "inf.toml", f'base = "{CASE3.as_posix()}"\n[parameters."contactors.0.stiffness"]\n'
+                  'values = ["4030 N/m", "inf"]\n[outputs]\nmetrics = ["max_response"]\n')
+    run = run_sweep(path, tmp_path / "inf.zarr", workers=0, progress=False)
+    assert run.computed == 2 and run.failed == 1
+    ds = run.dataset
+    assert "cannot be simulated" in str(ds["message"].values[1]) and np.isfinite(ds["max_response"].values[0])

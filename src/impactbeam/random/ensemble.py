@@ -139,7 +139,7 @@ def _aggregate(ds: xr.Dataset, confidence: float, has_fatigue: bool) -> dict[str
                 "contact_fraction": float(frac[c]), "contact_fraction_ci": _interval(flo[c], fhi[c]),
                 "duration_mean": float(pooled_mean(v["duration_mean"][:, c], n_complete[:, c])),
                 "impulse_mean": float(pooled_mean(v["impulse_mean"][:, c], n_complete[:, c])),
-                "n_impacts": int(np.sum(v["n_impacts"][:, c])),
+                "n_impacts": int(np.sum(v["window_impacts"][:, c])),
             })
     out["impacts"] = impacts
     fatigue = []

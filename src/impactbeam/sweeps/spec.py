@@ -293,7 +293,7 @@ class SweepSpec:
 
     @property
     def canonical_json(self) -> str:
-        return json.dumps(self.canonical(), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        return json.dumps(_jsonable(self.canonical()), sort_keys=True, separators=(",", ":"), allow_nan=False)
 
     @property
     def hash(self) -> str:
@@ -376,8 +376,19 @@ def default_batch_size(n_cases: int, case_bytes: float = 0.0) -> int:
     return max(1, size)
 
 
+def _jsonable(obj: Any) -> Any:
+    """``obj`` with every value :func:`_plain` (tables and lists walked)."""
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    return _plain(obj)
+
+
 def _plain(v: Any) -> Any:
-    return v.item() if isinstance(v, np.generic) else v
+    """A value as JSON holds it: a Python number (an infinite one, a rigid support's "inf", as that string)."""
+    v = v.item() if isinstance(v, np.generic) else v
+    return str(v) if isinstance(v, float) and math.isinf(v) else v
 
 
 def _draw(spec: SweepSpec) -> np.ndarray:
