@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import tomllib
+
 import numpy as np
 import pytest
 
@@ -25,6 +27,9 @@ def test_rows_are_bifurcation_sweeps_and_resume(tmp_path):
     ds = bifurcation_map(sc, X, Y, out, workers=0, **KW)
     assert ds["period"].dims == ("y", "x") and ds["strobe"].dims == ("y", "x", "sample")
     assert ds["done"].values.all()
+    # its provenance, as a sweep store's: the version, the scenario (it reloads to the same one), the tolerance
+    assert ds.attrs["impactbeam_version"] == ib.__version__ and ds.attrs["tolerance"] > 0
+    assert ib.parse_scenario(tomllib.loads(ds.attrs["scenario"])).to_toml() == sc.to_toml()
     # each row is exactly the continuation sweep along x at that y (same bits)
     row = bifurcation(sc.with_values({"excitation.amplitude": "2 g"}), *X, **KW)
     np.testing.assert_array_equal(ds["strobe"].values[1], np.stack([p.state.strobe for p in row.points]))

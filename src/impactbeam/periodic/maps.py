@@ -179,8 +179,13 @@ def bifurcation_map(
     path = Path(out)
     if not path.parent.is_dir():
         raise ParameterError(f'out: directory "{path.parent}" does not exist')
-    attrs = {"map_hash": _hash(scenario, xs, ys, sweep, settle, record, tolerance), "x_parameter": xs[0],
-             "y_parameter": ys[0], "sweep": sweep, "settle_periods": settle, "record_periods": record}
+    from ..result.dataset import provenance
+
+    attrs = {**provenance(f"impactbeam bifurcation map over {xs[0]} and {ys[0]}", "bifurcation-map",
+                          "strobe samples of exact piecewise modal runs, each row a continuation sweep along x"),
+             "map_hash": _hash(scenario, xs, ys, sweep, settle, record, tolerance), "x_parameter": xs[0],
+             "y_parameter": ys[0], "sweep": sweep, "settle_periods": settle, "record_periods": record,
+             "tolerance": tolerance, "scenario": scenario.to_toml()}
     units = (_unit(_dimension(xs[0], scenario)), _unit(_dimension(ys[0], scenario)))
     done = _open_or_create(path, _template(xs, ys, record, units, attrs))
     todo = [i for i in range(len(ys[1])) if not done[i]]
