@@ -604,20 +604,21 @@ def test_a_changed_trace_file_is_another_sweep(tmp_path):
         '[excitation]\nkind = "base_acceleration"\nshape = "table"\nfile = "pulse.csv"\n'
         "[solver]\nmodes = 4\nend_time = 0.02\n")
     _write(tmp_path, "b.toml", base)
-    path = _write(tmp_path, "s.toml", 'base = "b.toml"\n[parameters."excitation.scale"]\nvalues = [1.0, 2.0]\n'
-                  '[outputs]\nmetrics = ["max_response"]\n')
-    run_sweep(path, tmp_path / "s.zarr", workers=0, progress=False)
-    (tmp_path / "pulse.csv").write_text("t,a\n0,0\n0.005,300\n0.01,0\n")
-    with pytest.raises(ParameterError, match="holds the results of a different sweep"):
-        run_sweep(path, tmp_path / "s.zarr", workers=0, progress=False)
+
+    def refused_after(sweep_file, trace, amplitude):
+        """The sweep run, ``trace`` rewritten with another amplitude, the same sweep refused on its store."""
+        store = tmp_path / f"{sweep_file.stem}.zarr"
+        run_sweep(sweep_file, store, workers=0, progress=False)
+        (tmp_path / trace).write_text(f"t,a\n0,0\n0.005,{amplitude}\n0.01,0\n")
+        with pytest.raises(ParameterError, match="holds the results of a different sweep"):
+            run_sweep(sweep_file, store, workers=0, progress=False)
+
+    refused_after(_write(tmp_path, "s.toml", 'base = "b.toml"\n[parameters."excitation.scale"]\n'
+                         'values = [1.0, 2.0]\n[outputs]\nmetrics = ["max_response"]\n'), "pulse.csv", 300)
     # a trace named as a swept value: its numbers too (a store mixed the old and the new file's cases)
     (tmp_path / "other.csv").write_text("t,a\n0,0\n0.005,50\n0.01,0\n")
-    swept = _write(tmp_path, "f.toml", 'base = "b.toml"\n[parameters."excitation.file"]\n'
-                   'values = ["pulse.csv", "other.csv"]\n[outputs]\nmetrics = ["max_response"]\n')
-    run_sweep(swept, tmp_path / "f.zarr", workers=0, progress=False)
-    (tmp_path / "other.csv").write_text("t,a\n0,0\n0.005,25\n0.01,0\n")
-    with pytest.raises(ParameterError, match="holds the results of a different sweep"):
-        run_sweep(swept, tmp_path / "f.zarr", workers=0, progress=False)
+    refused_after(_write(tmp_path, "f.toml", 'base = "b.toml"\n[parameters."excitation.file"]\n'
+                         'values = ["pulse.csv", "other.csv"]\n[outputs]\nmetrics = ["max_response"]\n'), "other.csv", 25)
 
 
 def test_an_interrupt_before_the_first_case_says_nothing_was_written():
