@@ -580,6 +580,11 @@ def test_a_contactor_the_modes_do_not_reach_is_not_converged():
     assert auto.n_modes > 8 and auto.converged and auto.unseen_flexibility is None
     assert abs(auto.metrics(impacts=False)["max_penetration"] / reference - 1) < auto.tolerance
     assert ib.simulate(ib.load_scenario(EXAMPLES / "case03.toml")).unseen_flexibility is None
+    # the paper's basis has no function there at all with 8 modes: a penetration of 1e-36 m, in silence
+    paper = ib.simulate(_overhang(8).with_values({"solver.basis": "paper"}))
+    assert paper.metrics(impacts=False)["max_penetration"] < 1e-20 and paper.unseen_flexibility == (0, 1.0)
+    with pytest.warns(ib.ImpactBeamWarning, match=r"100 % of the static flexibility at contactor 0"):
+        paper.estimate_convergence()
 
 
 def test_the_study_does_not_recommend_a_count_whose_modes_miss_a_contactor():
