@@ -215,7 +215,7 @@ def _quantity_to_si(quantity: Any, text: str, dimension: str) -> float:
     target = ureg.parse_units(dim.pint_unit)
     if quantity.dimensionality != target.dimensionality:
         hint = ""
-        if dimension in _GRAVITY_DIMENSIONS and "g" in text and "[mass]" in str(quantity.dimensionality):
+        if dimension in _GRAVITY_DIMENSIONS and re.search(r"(?<![A-Za-z])mg(?![A-Za-z])", text):
             example = "15 g" if dimension == "acceleration" else "0.01 g^2/Hz"
             hint = f' (g written alone is standard gravity here, "{example}"; "mg" is a milligram)'
         raise _UnitProblem(
