@@ -41,7 +41,7 @@ from fe_cases import fe_changes, fe_metrics, fe_run
 from impactbeam.cli import main
 from impactbeam.simulation import convergence_study
 from impactbeam.solver.convergence import (
-    AUTO_COUNTS, CONVERGENCE_METRICS, coarser_counts, estimate, impact_changes, relative_changes,
+    AUTO_COUNTS, CONVERGENCE_METRICS, UNSEEN_SHARE, coarser_counts, estimate, impact_changes, relative_changes,
 )
 from test_ritz import _specimen, _structure_stop, _tip_stop
 
@@ -576,13 +576,16 @@ def test_a_contactor_the_modes_do_not_reach_is_not_converged():
         few.estimate_convergence()
     assert max(few.convergence.values()) < 1e-12 and not few.converged
     assert abs(few.metrics(impacts=False)["max_penetration"] / reference - 1) > 0.01  # what the warning is about
+    assert UNSEEN_SHARE == 0.9  # docs/convergence.md: "less than 10 % of a contactor's static flexibility"
     auto = ib.simulate(_overhang("auto"))
     assert auto.n_modes > 8 and auto.converged and auto.unseen_flexibility is None
     assert abs(auto.metrics(impacts=False)["max_penetration"] / reference - 1) < auto.tolerance
     assert ib.simulate(ib.load_scenario(EXAMPLES / "case03.toml")).unseen_flexibility is None
     # the paper's basis has no function there at all with 8 modes: a penetration of 1e-36 m, in silence
     paper = ib.simulate(_overhang(8).with_values({"solver.basis": "paper"}))
-    assert paper.metrics(impacts=False)["max_penetration"] < 1e-20 and paper.unseen_flexibility == (0, 1.0)
+    # (the modes' share there is round-off squared: 1 - share below 1e-20 measured, 1e-3 allowed on any machine)
+    assert paper.metrics(impacts=False)["max_penetration"] < 1e-20
+    assert paper.unseen_flexibility[0] == 0 and paper.unseen_flexibility[1] > 1.0 - 1e-3
     with pytest.warns(ib.ImpactBeamWarning, match=r"100 % of the static flexibility at contactor 0"):
         paper.estimate_convergence()
 

@@ -151,8 +151,10 @@ def from_diagram(scenario: Scenario, d: BifurcationDiagram) -> FrequencyResponse
 
 def _linear_curve(scenario: Scenario, f: np.ndarray, gain: float) -> tuple[np.ndarray, np.ndarray]:
     """``|H| A`` on 2001 frequencies over the range of ``f``, with its largest value refined to 1e-9 of its frequency."""
-    if not f.size or f.min() == f.max():
-        return f.copy(), np.abs(linear_frf(scenario, f)[:, 0]) * gain if f.size else np.empty(0)
+    if not f.size:
+        return np.empty(0), np.empty(0)
+    if f.min() == f.max():  # one frequency: nothing between swept values to miss
+        return f.copy(), np.abs(linear_frf(scenario, f)[:, 0]) * gain
     from scipy.optimize import minimize_scalar
 
     grid = np.linspace(f.min(), f.max(), 2001)

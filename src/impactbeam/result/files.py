@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from collections.abc import Mapping
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .._io import RESULT_SUFFIXES, atomic_path, write_netcdf
@@ -57,10 +57,10 @@ def write_result(result: SimulationResult, path: str | os.PathLike, *,
     check_output_size(result.time.size, result.points.size, len(result.contactors), result.solution.n_modes)
     from .dataset import result_attrs
 
-    attrs = result_attrs(result, report)
     if suffix == ".nc":
-        ds = result.to_xarray()
-        ds.attrs.update(attrs)
+        ds = result.to_xarray()  # with the run's own attributes (result_attrs)
+        if report is not None:
+            ds.attrs.update(result_attrs(result, report))
         write_netcdf(ds, path)
         return path
     table = result.to_dataframe()
@@ -68,6 +68,7 @@ def write_result(result: SimulationResult, path: str | os.PathLike, *,
         if suffix == ".csv":
             table.to_csv(tmp, index=False)
         else:  # Parquet keeps the attributes (pandas' attrs in its metadata); a CSV file has no place for them
+            attrs = result_attrs(result, report)
             table.attrs = {k: v if isinstance(v, (str, int, float)) else str(v) for k, v in attrs.items()}
             table.to_parquet(tmp, index=False)
     return path

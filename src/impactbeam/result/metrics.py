@@ -40,8 +40,8 @@ if TYPE_CHECKING:
     from .protocol import ResultLike
     from ..model.beam import Contactor
 
-__all__ = ["compute_metrics", "warn_unresolved", "contact_forces", "contact_intervals", "response_point", "pushing_parts",
-           "METRIC_UNITS", "METRIC_DISPLAY"]
+__all__ = ["compute_metrics", "warn_unresolved", "contact_forces", "contact_intervals", "response_point",
+           "pushing_parts", "METRIC_UNITS", "METRIC_DISPLAY"]
 
 #: Units of the scalar metrics (for labelled outputs).
 METRIC_UNITS = {

@@ -139,7 +139,7 @@ def _static_part(result: Any, space: Any, free: Any, x: np.ndarray, t: np.ndarra
         held = space.preload.excitation()  # as a step from t = 0 (Preload.excitation: its one reading as a load)
         Q += np.asarray(free.preload_weights, dtype=float)[None, :]
         out += float(held.scale * held.amplitude) * _excitation_static(beam, held, x)[None, :]
-    dash = getattr(result.solution, "dashpots", np.zeros(len(result.contactors)))
+    dash = result.solution.dashpots  # (the moment is the exact solution's: bending_moment reads sol.packed)
     for i, c in enumerate(result.contactors):
         # the force on the beam along +w: the contactor's law, k d + c d' (its dashpot's part too), while engaged
         f = np.where(smp.engaged[:, i], -c.direction * c.force(smp.w[:, i], smp.w_t[:, i], float(dash[i])), 0.0)

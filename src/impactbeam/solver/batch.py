@@ -222,6 +222,7 @@ def integrate_batch(
             break
     messages = []
     warnings: list[list[str]] = []
+    free_omega = pk.space.state(()).modes.omega  # the spectrum warning's (run_warnings), one structure
     errors: list[BaseException | None] = [failed.get(k) for k in range(n)]
     for k in range(n):
         if k in failed:
@@ -236,7 +237,7 @@ def integrate_batch(
                      float(warn[k, 4]), float(warn[k, 2]))
         warnings.append(run_warnings(int(status[k]), float(t_stop[k]), int(out[k, 8]), float(options[k].end_time),
                                      moved, (float(warn[k, 6]), float(warn[k, 7]), int(warn[k, 5]), options[k].modes),
-                                     (excitations[k], pk.space.state(()).modes.omega, options[k].modes)))
+                                     (excitations[k], free_omega, options[k].modes)))
     return BatchResult(out, status, t_stop, messages, warnings, errors)
 
 

@@ -7,6 +7,7 @@ spec resolves every case's values and hashes itself for resumable stores.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -259,7 +260,7 @@ class SweepSpec:
         for p in self.parameters:
             d: dict[str, Any] = {"path": p.path}
             if p.values is not None:
-                d["values"] = [_plain(v) for v in p.values]
+                d["values"] = list(p.values)  # (made plain for JSON with the rest: _jsonable)
             else:
                 d["distribution"] = p.distribution
                 d["args"] = list(p.args)
@@ -291,8 +292,9 @@ class SweepSpec:
                 out[p.path] = [_read_samples_digest(self.base.with_values({p.path: v})) for v in p.values]
         return out
 
-    @property
+    @functools.cached_property
     def canonical_json(self) -> str:
+        """:meth:`canonical` as JSON, computed once (it reads every file the sweep names)."""
         return json.dumps(_jsonable(self.canonical()), sort_keys=True, separators=(",", ":"), allow_nan=False)
 
     @property
