@@ -278,7 +278,7 @@ def test_a_density_above_the_retained_modes_is_warned_about():
     the root's fatigue damage 1.57e-2 against 2.45e-2 converged (8, 12 and 16 modes agree to 0.02 %), with 2 modes
     4.7 times low; no warning was given. The run, the batch of a sweep and the solve_ivp path now say it alike;
     with 12 modes (the 8th at 8996 Hz) none do."""
-    from impactbeam.simulation import Case, run_cases
+    from impactbeam.sweeps.cases import Case, run_cases
 
     L = 0.1092
     sc = ib.parse_scenario({

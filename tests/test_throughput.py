@@ -4,7 +4,7 @@ Every check here is bit-for-bit, with no tolerance: the paths compared run
 the same arithmetic in the same order (one BLAS thread), so any difference
 is a bug, not round-off.
 
-* a case run in a batch (:func:`impactbeam.simulation.run_cases`, the path of
+* a case run in a batch (:func:`impactbeam.sweeps.cases.run_cases`, the path of
   sweeps) against ``simulate_system(...).metrics(impacts=False)`` alone;
 * the interpreted twins of the kernels (the first-use path) against the
   compiled ones: segment records, events, samples, extrema and the metrics
@@ -30,7 +30,7 @@ from impactbeam.model.beam import Contactor, Support
 from impactbeam.model.loading import Excitation
 from impactbeam.model.starting import InitialCondition, Preload
 from impactbeam.result.metrics import METRIC_UNITS
-from impactbeam.simulation import Case, run_cases
+from impactbeam.sweeps.cases import Case, run_cases
 from impactbeam.solver import engine, kernels
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -119,6 +119,28 @@ def test_a_failing_case_fails_alone_in_its_batch():
     assert res.status.tolist() == [0, -1, 0]
     assert "contactors.0" in res.messages[1] and isinstance(res.errors[1], ib.ParameterError)
     np.testing.assert_array_equal(res.scalars[0], res.scalars[2])
+
+
+def test_a_case_warns_in_its_batch_as_it_warns_alone():
+    # Found by a hunt: a study's case lacked two warnings its run gives alone, impacts resolved only at the touch
+    # tolerance's scale (a restitution stop settling by ever smaller bounces: 2915 of its 2917 impacts at most
+    # 1.1e-11 m deep) and a response too small for the extrema (Case 3 at 1e-12 g: 6.8e-17 m). A batched case now
+    # warns as metrics(impacts=False) does alone, and that no longer needs the impact table to count them.
+    from impactbeam._warnings import WarningLog
+    from test_dissipation import _SETTLING
+
+    sc = _case3()
+    cases = [Case(s.beam, s.contactors, s.damping, s.excitation, s.initial, s.solver, s.output_points, s.preload)
+             for s in (ib.parse_scenario(_SETTLING), sc.with_values({"excitation.amplitude": "1e-12 g"}), sc)]
+    with pytest.warns(ib.ImpactBeamWarning, match="touch tolerances"):
+        res = run_cases(cases)
+    for k, c in enumerate(cases):
+        with WarningLog() as log:
+            _alone(c).metrics(impacts=False)
+        assert sorted(res.warnings[k]) == sorted(log.messages), k
+    assert any("2915 of 2917 impacts" in w for w in res.warnings[0])
+    assert any("the response is only ~6.8e-17 m" in w for w in res.warnings[1])
+    assert res.warnings[2] == []
 
 
 def _records(sol) -> list[np.ndarray]:
@@ -247,7 +269,7 @@ def test_batches_hold_a_bounded_memory_of_load_pieces(monkeypatch):
     # A batch pads every case's load pieces to the longest: 90 random loads of 100 s (800,000 samples each)
     # would hold ~5 GB at once. run_cases cuts a group into batches of at most BATCH_BYTES of pieces, and
     # a case gives the same bits in any of them.
-    import impactbeam.simulation as simulation
+    import impactbeam.sweeps.cases as cases_module
     import impactbeam.solver.batch as batch_module
 
     sc = _case3().with_values({
@@ -256,9 +278,9 @@ def test_batches_hold_a_bounded_memory_of_load_pieces(monkeypatch):
     })
     cases = [Case(s.beam, s.contactors, s.damping, s.excitation, s.initial, s.solver, s.output_points)
              for s in (sc.with_values({"excitation.seed": seed}) for seed in (1, 2, 3, 4, 5))]
-    per_case = simulation.case_bytes(cases[0])
+    per_case = cases_module.case_bytes(cases[0])
     assert per_case > 72 * cases[0].excitation.times.size  # the samples, their pieces and a margin
-    monkeypatch.setattr(simulation, "BATCH_BYTES", 2 * per_case)
+    monkeypatch.setattr(cases_module, "BATCH_BYTES", 2 * per_case)
     sizes = []
     real = batch_module.integrate_batch
     monkeypatch.setattr(batch_module, "integrate_batch", lambda *a, **k: (sizes.append(len(a[1])), real(*a, **k))[1])

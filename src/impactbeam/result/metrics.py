@@ -161,9 +161,9 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
     sol = result.solution
     x, sign = _metric_point(result)
     if hasattr(sol, "metric_arrays"):
-        scalars, rows = sol.metric_arrays(x, sign, impacts)
+        scalars, rows, shallow = sol.metric_arrays(x, sign, impacts)
     else:
-        scalars, rows = _queried_arrays(result, x, sign, impacts)
+        scalars, rows, shallow = _queried_arrays(result, x, sign, impacts)
     out = metrics_dict(scalars)
     arrays = getattr(sol, "event_arrays", None)
     if arrays is not None:  # without making the Event tuples
@@ -175,11 +175,12 @@ def compute_metrics(result: ResultLike, *, impacts: bool = True) -> dict[str, An
         if np.isfinite(scalars[0]):
             _clip_pulling(result, rows[0], rows[1], rows[3], rows[5], rows[6])
         out["impacts"] = _impact_table(result, rows) if np.isfinite(scalars[0]) else []
-        text = touch_scale_warning(rows, result.beam.length) if out["impacts"] else None
-        if text is not None:
-            from .._warnings import emit_user_level_warning
+    from ..solver.engine import touch_scale_warning
 
-            emit_user_level_warning(text)
+    for text in touch_scale_warning(shallow, result.beam.length):  # with the table or without, as in a batch
+        from .._warnings import emit_user_level_warning
+
+        emit_user_level_warning(text)
     return out
 
 
@@ -259,45 +260,6 @@ def _clip_pulling(result: ResultLike, rc: np.ndarray, ra: np.ndarray, rbe: np.nd
         impulse[i] = max(total, 0.0)
 
 
-#: An impact whose peak compression is at most this many touch tolerances (the engine's 1e-12 of the beam's
-#: length) is resolved only at that scale; :func:`touch_scale_warning` speaks of them from TOUCH_SCALE_COUNT on.
-TOUCH_SCALE = 100
-TOUCH_SCALE_COUNT = 10
-
-
-def touch_scale_warning(rows: tuple, length: float) -> str | None:
-    """The warning of impacts too shallow to count, or None (fewer than :data:`TOUCH_SCALE_COUNT` of them).
-
-    A contactor that bounces with every rebound smaller than the last (a
-    restitution or dashpot stop at a small gap, a beam settling onto it)
-    makes a sequence of impacts without end in theory; the engine follows it
-    down to the touch tolerance, so the impacts of its tail, each at most
-    :data:`TOUCH_SCALE` touch tolerances deep, are as many as that tolerance
-    makes them. With the paper's basis, a struck contactor the projection of
-    eq. (12) leaves on the wrong side makes contacts that never press the
-    stop at all. ``rows`` as :meth:`~impactbeam.solver.solution.Solution.metric_arrays`
-    returns them with the table.
-    """
-    from ..solver._codes import TOUCH
-
-    rc, start, _, _, compression, force = rows[:6]
-    depth = TOUCH_SCALE * TOUCH * length
-    shallow = np.isfinite(compression) & (compression <= depth)
-    n = int(np.count_nonzero(shallow))
-    if n < TOUCH_SCALE_COUNT:
-        return None
-    which = ", ".join(str(int(c)) for c in np.unique(rc[shallow]))
-    return (
-        f"metrics: {n} of {rc.size} impacts (contactor {which}, between t = {start[shallow].min():.6g} and "
-        f"{start[shallow].max():.6g} s) are at most {depth:.2g} m deep ({TOUCH_SCALE} touch tolerances; peak force "
-        f"at most {np.nanmax(force[shallow]):.2g} N), contacts resolved only at the scale of the touch tolerance "
-        "(1e-12 of the beam length): a contact settling onto its stop by ever smaller bounces (a dashpot or "
-        "restitution stop at a small gap) makes such impacts without end, as many as that tolerance resolves, and "
-        "with the paper's basis a projection can leave a struck contactor on the wrong side (see the projection's "
-        "warning); n_impacts and the impact table count them"
-    )
-
-
 def metrics_dict(scalars: np.ndarray) -> dict[str, Any]:
     """The scalar metrics as the dictionary of :func:`compute_metrics` (None for NaN, counts as int).
 
@@ -318,6 +280,7 @@ _COUNTS = ("n_impacts", "n_events")
 def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> tuple[np.ndarray, tuple]:
     """:meth:`~impactbeam.solver.solution.Solution.metric_arrays` for any solution, through its queries."""
     from ..solver import kernels
+    from ..solver._codes import TOUCH_SCALE_COUNT, touch_depth
 
     K = kernels.for_work(len(result.events))
     sol = result.solution
@@ -343,10 +306,12 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
     peaks = np.full(n_rows, np.nan)
     contact = np.full(5, np.nan)
     peak_after = np.nan
+    counted = False
     if nc:
         K.first_contact(ev_t, ev_kind, ev_c, nev, t_top, contact)
         a, b = contact[3], contact[4]
-        want = [i for i in range(n_rows) if table or (rc[i] == 0 and ra[i] == a)]
+        counted = n_rows >= TOUCH_SCALE_COUNT and np.isfinite(top)  # every peak, for count_shallow
+        want = [i for i in range(n_rows) if table or counted or (rc[i] == 0 and ra[i] == a)]
         if want:
             peaks[want] = sol.extrema([_peak_query(result, int(rc[i]), ra[i], rbe[i]) for i in want])[:, 0]
         if np.isfinite(top) and np.isfinite(a) and a < t_end and not np.any((rc == 0) & (ra == a)):
@@ -359,6 +324,9 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
         pen = np.ascontiguousarray(getattr(sol, "event_penetrations", np.zeros(nev)), dtype=float)
         energy = (-K.pairwise_sum(jumps, jumps.size)
                   - K.release_loss_sum(ev_c, ev_kind, pen, nev, dash, kst, np.empty(max(nev, 1))))
+    shallow = np.zeros(4 + nc)
+    if nc and counted:
+        K.count_shallow(rc, ra, peaks, n_rows, touch_depth(result.beam.length), shallow)
     out = np.empty(K.N_SCALARS)
     low, deepest = (float(ext[1, 0]), np.nan) if not nc else (np.nan, float(ext[1, 0]))
     K.assemble(out, nev, top, t_top, low, energy, deepest, n_rows, rc, ra, peaks, contact, con[0].gap if nc else 0.0,
@@ -377,7 +345,7 @@ def _queried_arrays(result: ResultLike, x: float, sign: float, table: bool) -> t
                 w = sol.sample(np.array([c.position]), np.array([ra[i], rbe[i]])).w[:, 0]
                 d0[i], d1[i] = c.direction * w - c.gap
         fpeaks, ints = _forces(result, rc, ra, rbe, fpeaks, np.asarray(ints, dtype=float), d0, d1)
-    return out, (rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1)
+    return out, (rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1), shallow
 
 
 def _peak_query(result: ResultLike, ci: int, a: float, be: float) -> tuple:
@@ -480,7 +448,23 @@ def _impact_table(result: ResultLike, rows: tuple) -> list[dict[str, Any]]:
     ]
 
 
-def warn_unresolved(result: ResultLike, metrics: dict[str, Any]) -> None:
+def response_size(metrics: dict[str, Any]) -> float:
+    """The larger of ``|max_response|`` and ``|min_response|`` (0 where undefined): what :func:`warn_unresolved` weighs.
+
+    Parameters
+    ----------
+    metrics : dict
+        Metrics of :func:`compute_metrics` (or :func:`metrics_dict`).
+    """
+    return max((abs(v) for v in (metrics.get("max_response"), metrics.get("min_response")) if v is not None),
+               default=0.0)
+
+
+#: A response smaller than this fraction of the beam's length is not resolved by the extrema (:func:`warn_unresolved`).
+UNRESOLVED = 1e-9
+
+
+def warn_unresolved(result: ResultLike, metrics: dict[str, Any], driven: bool | None = None) -> None:
     """Warn when the response is too small for the extrema's absolute tolerance (1e-12 of the length).
 
     Parameters
@@ -488,19 +472,22 @@ def warn_unresolved(result: ResultLike, metrics: dict[str, Any]) -> None:
     result : SimulationResult
     metrics : dict
         Its metrics (:func:`compute_metrics`).
+    driven : bool, optional
+        Whether a load or a starting motion drives the run (default: read
+        from the result's scenario, else whether the response is not 0).
     """
-    peak = max((abs(v) for v in (metrics.get("max_response"), metrics.get("min_response")) if v is not None),
-               default=0.0)
+    peak = response_size(metrics)
     sc = getattr(result, "scenario", None)
-    driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
+    if driven is None:
+        driven = peak > 0.0 if sc is None else (sc.excitation.active or not sc.initial.at_rest)
     length = result.beam.length
-    if driven and peak < 1e-9 * length and result.contactors:
+    if driven and peak < UNRESOLVED * length and result.contactors:
         # u may only have moved towards the stop, without reaching it (max_response the start's 0,
         # min_response undefined): the least u over the run then says how large the response is
         x, sign = response_point(result.contactors, result.points)
         sol = result.solution
         peak = max(peak, float(sol.extrema([(x, 0.0, sol.t_end, -sign, 0.0, None)])[0, 0]))
-    if driven and peak < 1e-9 * length:
+    if driven and peak < UNRESOLVED * length:
         from .._warnings import emit_user_level_warning
 
         emit_user_level_warning(

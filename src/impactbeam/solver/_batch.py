@@ -71,7 +71,8 @@ def run_batch(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_f
               gaps, sides, pt0, pt1, pconst, pslope, pamp, pOm, pphase, npieces, T_end, xtol, max_events,
               eta0, deta0, tol_h, budget, Wm, Wcp, sign, atol, bc, fc, ic, eta, deta, own_e, own_d, toggles, phase,
               held, seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_v, ev_d, jumps,
-              out, out_status, out_t, out_warn, rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1):
+              out, out_status, out_t, out_warn, depth, min_count, out_shallow, rc, ra, rb, rbe, peaks, fpeaks, ints, d0,
+              d1):
     # pragma: no cover - compiled
     """Run (or resume) cases ``bc[B_CASE]`` ... of the batch; a status code (module docstring).
 
@@ -82,7 +83,9 @@ def run_batch(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_f
     Results: ``out[k]`` the scalar metrics (:data:`~impactbeam.solver._metrics.SCALARS`),
     ``out_status[k]`` (0 end time reached, 1 chattering guard), ``out_t[k]``
     where the run stopped, ``out_warn[k]`` the loop's projection warning
-    (count, contactor, time, moved, scale) and the number of switches.
+    (count, contactor, time, moved, scale) and the number of switches,
+    ``out_shallow[k]`` the impacts at most ``depth`` deep
+    (:func:`~impactbeam.solver._metrics.count_shallow`, from ``min_count`` contacts on).
     ``DONE`` when every case is done.
     """
     n_cases = gaps.shape[0]
@@ -125,7 +128,7 @@ def run_batch(reg, dec, wdh, om, omo, Wc, LW, CW, RW, gen, G, H, smask, Tm, tr_f
                     ev_t[:nev], ev_kind[:nev], ev_c[:nev], ev_d[:nev], nev, jumps[:ic[I_NJUMP]], t_end, reg, dec,
                     wdh, om, LW, CW, gen, G, smask, gaps[k], sides[k], kst, dash, pt0[k, :n], pconst[k, :n],
                     pslope[k, :n], pamp[k, :n], pOm[k, :n], pphase[k, :n], Wm, Wcp, sign[k], atol, 1e-14, False,
-                    out[k], rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1, work)
+                    depth, min_count, out_shallow[k], out[k], rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1, work)
         bc[B_CASE] = k + 1
         bc[B_STARTED] = 0
         if bc[B_STOP_EACH]:

@@ -13,7 +13,7 @@ __all__ = ["DONE", "CHATTER", "NEED_STATE", "NEED_TRANSFER", "NEED_SPACE", "CHEC
            "I_SLOT", "I_PIECE", "I_JUST", "I_PENDING", "I_NSEG", "I_NEV", "I_NJUMP", "I_NSLOTS", "I_NTR",
            "I_WARN_C", "REQ_A", "REQ_B", "I_RESUME", "I_EVALS", "I_SAME", "I_WARN_N", "I_USED", "N_INT",
            "F_T", "F_LAST_T", "F_WARN_T", "F_WARN_MOVED", "F_WARN_SCALE", "F_TAU", "F_E_SUM", "F_E_PEAK", "N_FLOAT",
-           "MOVED_WARN", "MOVED_FLOOR", "ENERGY_WARN", "TOUCH"]
+           "MOVED_WARN", "MOVED_FLOOR", "ENERGY_WARN", "TOUCH", "TOUCH_SCALE", "TOUCH_SCALE_COUNT", "touch_depth"]
 
 DONE, CHATTER, NEED_STATE, NEED_TRANSFER, NEED_SPACE, CHECKPOINT = 0, 1, 2, 3, 4, 5
 CASE_DONE = 6  # a batch finished a case and stops after each (a continuation)
@@ -37,3 +37,13 @@ MOVED_FLOOR = 1e6
 ENERGY_WARN = 0.05
 # the touch tolerance, as a fraction of the beam's length: a row within TOUCH L of its surface touches it (tol_h)
 TOUCH = 1e-12
+# an impact whose peak compression is at most TOUCH_SCALE touch tolerances is resolved only at that scale; the
+# metrics count such impacts (_metrics.run_metrics) once a run has TOUCH_SCALE_COUNT contacts, and warn of them
+# from TOUCH_SCALE_COUNT on (engine.touch_scale_warning), alone or in a batch
+TOUCH_SCALE = 100
+TOUCH_SCALE_COUNT = 10
+
+
+def touch_depth(length: float) -> float:
+    """The depth [m] below which an impact is resolved only at the touch tolerance's scale (beam ``length`` [m])."""
+    return TOUCH_SCALE * TOUCH * float(length)

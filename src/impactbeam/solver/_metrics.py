@@ -34,7 +34,7 @@ from ._dense import extremum_query, integral_query, sample_row
 from ._jit import njit
 
 __all__ = ["N_SCALARS", "SCALARS", "contact_rows", "assemble", "run_metrics", "impact_forces", "pairwise_sum",
-           "release_loss_sum"]
+           "release_loss_sum", "count_shallow"]
 
 #: Order of the scalar metrics in the arrays of this module (NaN where undefined).
 SCALARS = ("max_response", "t_max", "first_impact_time", "n_impacts", "free_duration", "contact_duration",
@@ -219,6 +219,33 @@ def assemble(out, nev, top, t_top, low, energy_residual, deepest, n_rows, rc, ra
 
 
 @njit(cache=True, nogil=True, _nrt=False)
+def count_shallow(rc, ra, peaks, n_rows, depth, shallow):  # pragma: no cover - compiled
+    """The contacts whose peak compression ``peaks[i]`` is at most ``depth``, in place of ``shallow``.
+
+    ``shallow[0]`` their number, ``shallow[1]`` the number of rows,
+    ``shallow[2]`` and ``shallow[3]`` the first and last of their starts,
+    ``shallow[4 + c]`` 1 where contactor ``c`` has one (0 elsewhere); a NaN
+    peak is not counted. The rule behind
+    :func:`impactbeam.solver.engine.touch_scale_warning`.
+    """
+    for j in range(shallow.size):
+        shallow[j] = 0.0
+    first = math.inf
+    last = -math.inf
+    for i in range(n_rows):
+        p = peaks[i]
+        if math.isfinite(p) and p <= depth:
+            shallow[0] += 1.0
+            first = min(first, ra[i])
+            last = max(last, ra[i])
+            shallow[4 + rc[i]] = 1.0
+    shallow[1] = n_rows
+    if shallow[0] > 0.0:
+        shallow[2] = first
+        shallow[3] = last
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def impact_forces(rc, ra, rbe, fpeaks, ints, d0, d1, n, side, gap, kst, dash):  # pragma: no cover - compiled
     """Peak force and impulse of contact intervals, in place of ``fpeaks`` and ``ints``.
 
@@ -246,7 +273,8 @@ def impact_forces(rc, ra, rbe, fpeaks, ints, d0, d1, n, side, gap, kst, dash):  
 @njit(cache=True, nogil=True)
 def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, ev_c, ev_d, nev, jumps, t_end,
                 reg, dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, dash, pt0, pconst, pslope, pamp, pOm,
-                pphase, Wm, Wc, sign, atol, xtol, table, out, rc, ra, rb, rbe, peaks, fpeaks, ints, d0, d1, work):
+                pphase, Wm, Wc, sign, atol, xtol, table, depth, min_count, shallow, out, rc, ra, rb, rbe, peaks, fpeaks,
+                ints, d0, d1, work):
     # pragma: no cover - compiled
     """The metrics of one run (module docstring); returns the number of rows.
 
@@ -257,7 +285,11 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
     per-impact table: contactor, start, end, clipped end, peak compression
     ``s w - gap``, and with ``table`` the peak force (``fpeaks``) and the
     impulse (``ints``) of :func:`impact_forces` and the compression at both
-    ends of dashpot contactors (``d0, d1``; NaN for the others). ``work`` from
+    ends of dashpot contactors (``d0, d1``; NaN for the others). ``shallow``
+    receives :func:`count_shallow` of the rows at most ``depth`` deep when
+    there are ``min_count`` rows or more (zeros otherwise): a row the table
+    does not hold is sampled at its middle first and searched only when that
+    sample is not deeper. ``work`` from
     :func:`~impactbeam.solver._dense.dense_work`, its last array resized to
     ``nev`` floats by the caller's ``scratch``.
     """
@@ -330,4 +362,21 @@ def run_metrics(seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, ev_t, ev_kind, 
                                              om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp,
                                              pOm, pphase, work) - gap[c]
         impact_forces(rc, ra, rbe, fpeaks, ints, d0, d1, n_rows, side, gap, kst, dash)
+    for j in range(shallow.size):
+        shallow[j] = 0.0
+    if n_rows >= min_count and math.isfinite(top):
+        deep = np.empty(n_rows)
+        for i in range(n_rows):
+            p = peaks[i]
+            c = rc[i]
+            if np.isnan(p):  # not in the table: deeper than depth at its middle, or searched
+                p = side[c] * sample_row(0.5 * (ra[i] + rbe[i]), Wc[c], seg_t0, seg_s, seg_k, seg_eta, seg_deta, reg,
+                                         dec, wdh, om, LW, CW, gen, G, smask, gap, side, kst, pt0, pconst, pslope,
+                                         pamp, pOm, pphase, work) - gap[c]
+                if p <= depth:
+                    p, _ = extremum_query(ra[i], rbe[i], side[c], -side[c] * gap[c], 0.0, Wc[c], c, atol, xtol,
+                                          seg_t0, seg_t1, seg_s, seg_k, seg_eta, seg_deta, reg, dec, wdh, om, LW, CW,
+                                          gen, G, smask, gap, side, kst, pt0, pconst, pslope, pamp, pOm, pphase, work)
+            deep[i] = p
+        count_shallow(rc, ra, deep, n_rows, depth, shallow)
     return n_rows

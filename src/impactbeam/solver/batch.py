@@ -168,6 +168,7 @@ def integrate_batch(
     status = np.full(n, -1, dtype=np.int64)
     t_stop = np.zeros(n)
     warn = np.zeros((n, 8))
+    shallow = np.zeros((n, 4 + nc))
     failed: dict[int, BaseException] = {}
 
     def table_rows() -> tuple[np.ndarray, ...]:
@@ -189,7 +190,8 @@ def integrate_batch(
             pk.tr_from, pk.tr_to, kst, pk.dash, gaps, sides, pt0, pt1, pconst, pslope, pamp, pOm, pphase, npieces,
             T_end, xtol, max_events, eta0, deta0, tol_h, _BUDGET, Wm, Wcp, sign_arr, atol, bc, fc, ic, *carry,
             rec.seg_t0, rec.seg_t1, rec.seg_s, rec.seg_k, rec.seg_eta, rec.seg_deta, rec.ev_t, rec.ev_kind,
-            rec.ev_c, rec.ev_v, rec.ev_d, rec.jumps, out, status, t_stop, warn, *rows,
+            rec.ev_c, rec.ev_v, rec.ev_d, rec.jumps, out, status, t_stop, warn, _loop.touch_depth(beam.length),
+            _loop.TOUCH_SCALE_COUNT, shallow, *rows,
         ))
         k = int(bc[K.B_CASE])
         if st == _loop.NEED_STATE or st == _loop.NEED_TRANSFER:
@@ -237,7 +239,8 @@ def integrate_batch(
                      float(warn[k, 4]), float(warn[k, 2]))
         warnings.append(run_warnings(int(status[k]), float(t_stop[k]), int(out[k, 8]), float(options[k].end_time),
                                      moved, (float(warn[k, 6]), float(warn[k, 7]), int(warn[k, 5]), options[k].modes),
-                                     (excitations[k], free_omega, options[k].modes)))
+                                     (excitations[k], free_omega, options[k].modes),
+                                     (shallow[k], beam.length)))
     return BatchResult(out, status, t_stop, messages, warnings, errors)
 
 

@@ -476,25 +476,59 @@ def stop_message(status: int, t_stop: float, n_events: int) -> str:
 
 def run_warnings(status: int, t_stop: float, n_events: int, end_time: float,
                  moved: tuple | None = None, energy: tuple | None = None,
-                 spectrum: tuple | None = None) -> list[str]:
+                 spectrum: tuple | None = None, shallow: tuple | None = None) -> list[str]:
     """The warnings of a run, for the single run, the batch and the ``solve_ivp`` path alike.
 
     The projection's (``moved``: the arguments of :func:`projection_warning`,
     None when no switch moved a contactor's deflection that much), the
     projections' energy changes (``energy``: the arguments of
     :func:`energy_warning`), a random load reaching above the retained modes
-    (``spectrum``: the arguments of :func:`spectrum_warning`), and a stop by
-    the chattering guard (``status`` 1), whose results cover only ``[0, t_stop]``.
+    (``spectrum``: the arguments of :func:`spectrum_warning`), impacts
+    resolved only at the touch tolerance's scale (``shallow``: the arguments
+    of :func:`touch_scale_warning`; the batch's, a single run's metrics give
+    theirs), and a stop by the chattering guard (``status`` 1), whose results
+    cover only ``[0, t_stop]``.
     """
     out = [] if moved is None else [projection_warning(*moved)]
     if energy is not None and energy[0] > _loop.ENERGY_WARN * energy[1]:
         out.append(energy_warning(*energy))
     if spectrum is not None:
         out.extend(spectrum_warning(*spectrum))
+    if shallow is not None:
+        out.extend(touch_scale_warning(*shallow))
     if status == 1:
         out.append(f"{stop_message(status, t_stop, n_events)} The results cover 0 to {t_stop:.6g} s of the "
                    f"{end_time:.6g} s asked: metrics are of that part, later samples are NaN.")
     return out
+
+
+def touch_scale_warning(shallow: np.ndarray, length: float) -> list[str]:
+    """The warning of impacts resolved only at the touch tolerance's scale (or none).
+
+    A contactor that bounces with every rebound smaller than the last (a
+    restitution or dashpot stop at a small gap, a beam settling onto it)
+    makes a sequence of impacts without end in theory; the engine follows it
+    down to the touch tolerance (``TOUCH`` of the beam's ``length``), so the
+    impacts of its tail, each at most ``TOUCH_SCALE`` touch tolerances deep,
+    are as many as that tolerance makes them. With the paper's basis, a
+    struck contactor the projection of eq. (12) leaves on the wrong side
+    makes contacts that never press the stop at all. ``shallow`` is what
+    :func:`~impactbeam.solver._metrics.count_shallow` counted; from
+    ``TOUCH_SCALE_COUNT`` such impacts on they are warned about.
+    """
+    n = int(shallow[0])
+    if n < _loop.TOUCH_SCALE_COUNT:
+        return []
+    which = ", ".join(str(c) for c in np.flatnonzero(np.asarray(shallow[4:]) > 0.0))
+    return [
+        f"metrics: {n} of {int(shallow[1])} impacts (contactor {which}, between t = {shallow[2]:.6g} and "
+        f"{shallow[3]:.6g} s) are at most "
+        f"{_loop.touch_depth(length):.2g} m deep ({_loop.TOUCH_SCALE} touch tolerances), contacts resolved only at "
+        f"the scale of the touch tolerance ({_loop.TOUCH:g} of the beam length): a contact settling onto its stop by "
+        "ever smaller bounces (a dashpot or restitution stop at a small gap) makes such impacts without end, as many "
+        "as that tolerance resolves, and with the paper's basis a projection can leave a struck contactor on the "
+        "wrong side (see the projection's warning); n_impacts and the impact table count them"
+    ]
 
 
 def spectrum_warning(excitation: Any, omega: np.ndarray, modes: int) -> list[str]:

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..exceptions import ParameterError
 from . import kernels
-from ._codes import TOUCH
+from ._codes import TOUCH, TOUCH_SCALE_COUNT, touch_depth
 
 if TYPE_CHECKING:
     from ..model.beam import Contactor
@@ -463,6 +463,10 @@ class Solution(PiecewiseSolution):
             [N], impulse [N s] and the compression at both ends (NaN without
             a dashpot), one entry per contact interval (the last five with
             ``table`` only).
+        shallow : ndarray, (4 + n_contactors,)
+            The impacts resolved only at the touch tolerance's scale
+            (:func:`~impactbeam.solver._metrics.count_shallow`; zeros below
+            ``TOUCH_SCALE_COUNT`` contacts).
         """
         K = kernels.for_work(self.n_segments + self.event_arrays[0].size)
         pk = self.packed
@@ -471,15 +475,17 @@ class Solution(PiecewiseSolution):
         n = nev + len(self.contactors) + 1
         rows = (np.zeros(n, dtype=np.int64), *np.zeros((8, n)))
         out = np.empty(K.N_SCALARS)
+        shallow = np.zeros(4 + len(self.contactors))
         Wm, Wc = self.metric_rows(x)
         pcs = self.pieces
         n_rows = K.run_metrics(
             self.t0, self.t1, self.slot, self.piece, self.eta0, self.deta0, ev_t, ev_kind, ev_c,
             self.event_penetrations, nev, self.energy_jumps, float(self.t_end), pk.reg, pk.dec, pk.wdh, pk.om, pk.LW,
             pk.CW, pk.gen, pk.G, pk.smask, *self.contactor_arrays, pk.dash, pcs[0], *pcs[2:], Wm, Wc, float(sign),
-            self._atol, 1e-14, bool(table), out, *rows, _work(K, self.n_modes),
+            self._atol, 1e-14, bool(table), touch_depth(pk.space.beam.length), TOUCH_SCALE_COUNT, shallow, out, *rows,
+            _work(K, self.n_modes),
         )
-        return out, tuple(r[:n_rows] for r in rows)
+        return out, tuple(r[:n_rows] for r in rows), shallow
 
     def metric_rows(self, x: float) -> tuple[np.ndarray, np.ndarray]:
         """Shapes at ``x`` (S, n) and at each contactor (n_c, S, n) in every built state slot.

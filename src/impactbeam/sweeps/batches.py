@@ -1,6 +1,6 @@
 """Batches of cases: the chunks of the store, and running one batch in a worker.
 
-A batch's cases run through :func:`impactbeam.simulation.run_cases`: those
+A batch's cases run through :func:`impactbeam.sweeps.cases.run_cases`: those
 that share their packed problem (the usual case: a batch holds one geometry)
 run in one compiled call, metrics included. Building a case is cheap too:
 the paths in :data:`_DIRECT` (gaps, sides, the load's amplitude, duration,
@@ -162,7 +162,7 @@ _DIRECT = re.compile(
 
 
 class _CaseBuilder:
-    """The cases of a sweep as :class:`~impactbeam.simulation.Case` objects (module docstring).
+    """The cases of a sweep as :class:`~impactbeam.sweeps.cases.Case` objects (module docstring).
 
     One per worker process and sweep (:func:`_builder`): the scenarios of
     the other paths' values, the direct values as the parser reads them and
@@ -190,7 +190,7 @@ class _CaseBuilder:
 
     def _whole(self, vals: Sequence[Any]) -> Any:
         """The case from the scenario re-parsed with all its values (or the exception)."""
-        from ..simulation import Case
+        from .cases import Case
 
         try:
             sc = self.base.with_values(dict(zip(self.paths, vals)))
@@ -201,7 +201,7 @@ class _CaseBuilder:
 
     def _direct(self, vals: Sequence[Any]) -> Any:
         """The case built from the group's scenario and the direct values, or None (parse it whole)."""
-        from ..simulation import Case
+        from .cases import Case
 
         gkey = repr([vals[i] for i in self.other])
         group = self._groups.get(gkey)
@@ -295,7 +295,7 @@ def run_batch(batch: _Batch) -> dict[str, Any]:
         The cases of one chunk of the store.
     """
     from ..result.metrics import METRIC_UNITS
-    from ..simulation import BATCH_BYTES, case_bytes, run_cases
+    from .cases import BATCH_BYTES, case_bytes, run_cases
 
     _tune_malloc()
     n = len(batch.values)
