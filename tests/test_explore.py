@@ -57,6 +57,74 @@ def test_model_matches_simulate_and_round_trips_toml(tmp_path: Path) -> None:
     assert again.contactors[0].gap == pytest.approx(0.300e-3, rel=1e-15) and again.solver.modes == 6
 
 
+def _with(base: Path, edit) -> ib.Scenario:
+    import copy
+
+    data = copy.deepcopy(ib.load_scenario(base).data)
+    edit(data)
+    return ib.parse_scenario(data, base_dir=base.parent)
+
+
+@pytest.mark.filterwarnings("ignore:Stopped at")
+def test_the_explorer_shows_what_simulate_gives_for_any_damping_and_stop() -> None:
+    # Found by a hunt: the explorer replaced per-mode damping ratios by the first one (max penetration 5 % off
+    # on the first draw), could not open a free-mode damping scenario (it wrote damping.contact, which that model
+    # refuses), drew a restitution stop's force without its dashpot (0.64 N where the force is 1.72 N), and showed
+    # a run stopped early as complete. Now only a moved slider is written, the force is Contactor.force with the
+    # run's dashpot, and the run's warnings are returned (the page shows them under the sliders).
+    import numpy as np
+
+    from impactbeam.explore import ExplorerModel
+
+    def perm(d):
+        d["damping"].update(free=[0.011, 0.10], contact=[0.02, 0.10])
+
+    def stop_early(d):
+        d["solver"]["max_events"] = 6
+
+    cases = [_with(CASE3, perm), ib.load_scenario(ROOT / "examples" / "validation" / "sdnl32_k18000.toml"),
+             _with(CASE3, lambda d: d["contactors"][0].update(restitution=0.5)), _with(CASE3, stop_early)]
+    for sc in cases:
+        model = ExplorerModel(sc)
+        assert not {"damping_free", "damping_contact"} & set(model.values) or sc.damping.model == "modal"
+        out = model.run()
+        res = ib.simulate(sc)
+        ref = res.metrics()
+        for key in ("max_response", "first_impact_time", "n_impacts", "max_penetration"):
+            assert out["metrics"][key] == ref[key], (sc.name, key)
+        if sc.contactors:  # the same force as the result's on the same grid (one rule, to round-off)
+            force = res.contact_force[:, 0]
+            ok = np.isfinite(force)
+            np.testing.assert_allclose(out["force_N"][ok], force[ok], rtol=1e-12, atol=1e-12 * np.nanmax(force))
+    assert any("Stopped at" in w for w in ExplorerModel(cases[3]).run()["warnings"])
+    assert "damping_free" not in ExplorerModel(cases[0]).values
+
+
+def test_the_explorer_controls_keep_the_scenarios_own_values(tmp_path: Path) -> None:
+    # a negative amplitude keeps its sign in the slider's range, a contactor near the root its own position, the
+    # amplitude's label says excitation.scale, and a saved scenario naming a trace file loads from anywhere
+    from impactbeam.explore import SLIDERS, ExplorerModel
+
+    sc = _with(CASE3, lambda d: (d["excitation"].update(amplitude="-15 g", scale=2.0),
+                                 d["contactors"][0].update(position_ratio=0.02)))
+    model = ExplorerModel(sc)
+    lo, hi = model.bounds("amplitude")
+    assert lo < model.values["amplitude"] < hi < 0
+    assert model.bounds("position_ratio")[0] <= 0.02
+    label = model.label(next(s for s in SLIDERS if s.name == "amplitude"))
+    assert label == "pulse amplitude [g, times excitation.scale = 2]"
+
+    def traced(d):
+        for key in ("amplitude", "duration"):
+            d["excitation"].pop(key, None)
+        d["excitation"].update(shape="table", file="measured/base_acceleration.csv")
+
+    table = _with(CASE3, traced)
+    path = tmp_path / "saved.toml"
+    path.write_text(ExplorerModel(table).toml())
+    assert ib.load_scenario(path).excitation.values.tolist() == table.excitation.values.tolist()
+
+
 def test_envelope_keeps_the_extremes() -> None:
     import numpy as np
 

@@ -52,5 +52,4 @@ def explore(scenario: str | None, port: int, show: bool) -> None:
         from ._group import load_with_overrides
 
         sc = load_with_overrides(scenario)
-    click.echo(f"impactbeam explorer on http://127.0.0.1:{port}/ (Ctrl-C to stop)", err=True)
-    serve(sc, port=port, show=show)
+    serve(sc, port=port, show=show, announce=lambda text: click.echo(text, err=True))

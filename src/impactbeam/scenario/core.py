@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import os
 import tomllib
 from collections.abc import Mapping
@@ -92,8 +93,21 @@ class Scenario:
     preload: Preload | None = None
 
     def to_toml(self) -> str:
-        """The scenario as TOML text (``load_scenario`` of it gives the same scenario)."""
-        return scenario_toml(self.data)
+        """The scenario as TOML text (``load_scenario`` of it gives the same scenario, from any directory).
+
+        The files it names relative to its directory (``excitation.file``,
+        ``initial.*_file``) are written as absolute paths.
+        """
+        if self.base_dir is None:
+            return scenario_toml(self.data)
+        data = copy.deepcopy(self.data)
+        tables = [data.get("excitation"), data.get("initial")]
+        for table in (t for t in tables if isinstance(t, dict)):
+            for key, value in table.items():
+                if (key == "file" or key.endswith("_file")) and isinstance(value, str):
+                    path = Path(value).expanduser()
+                    table[key] = str(path if path.is_absolute() else (Path(self.base_dir) / path).resolve())
+        return scenario_toml(data)
 
     @property
     def description(self) -> str | None:
