@@ -192,6 +192,27 @@ def test_cli_fit_json(setup, tmp_path):
     assert d["success"] and out.exists() and (tmp_path / "fit_excitation.csv").exists()
 
 
+def test_cli_fit_that_does_not_converge_exits_1_and_writes_nothing(setup, tmp_path):
+    """Found by a hunt: with --max-nfev 3 the fit stopped unconverged, exited 0 and wrote a "fitted" scenario
+    (k = 5416 N/m where the truth is 5200). A failed computation exits 1: the report, then one error line."""
+    base, trace, meas = setup
+    mp = tmp_path / "defl.csv"
+    mp.write_text("time [s],deflection [mm]\n" + "\n".join(
+        f"{float(a)!r},{float(b) * 1e3!r}" for a, b in zip(meas.time, meas.values)))
+    tp = tmp_path / "acc.csv"
+    tp.write_text("time [s],acceleration [g]\n" + "\n".join(
+        f"{float(a)!r},{float(b) / G!r}" for a, b in zip(trace.time, trace.values)))
+    out = tmp_path / "fit.toml"
+    proc = subprocess.run(
+        [str(CLI), "fit", str(EXAMPLES / "case03.toml"), str(mp), "--excitation", str(tp),
+         "--params", "contactors.0.stiffness,excitation.scale", "--max-nfev", "3", "--out", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert proc.returncode == 1, proc.stderr
+    assert "NOT converged" in proc.stdout and "the fit did not converge" in proc.stderr
+    assert not out.exists() and not (tmp_path / "fit_excitation.csv").exists()
+
+
 def test_cli_fit_bad_bounds_exit_2(setup, tmp_path):
     _, _, meas = setup
     mp = tmp_path / "defl.csv"

@@ -16,7 +16,7 @@ import click
 
 from .._io import PLOT_SUFFIXES, WriteError, check_output, json_text
 from ._group import handle_errors, number_or_text, take_warnings
-from ..exceptions import ParameterError
+from ..exceptions import ImpactBeamError, ParameterError
 
 __all__ = ["compare", "fit", "identify"]
 
@@ -322,7 +322,8 @@ def fit(
     Each parameter starts at the scenario's value; the report gives the
     fitted values with standard errors and linearised 95 % intervals.
     With --out the fitted scenario is written as TOML (and a measured trace
-    beside it as <stem>_excitation.csv).
+    beside it as <stem>_excitation.csv). A fit that does not converge exits
+    with status 1 after its report and writes nothing.
     """
     from ..experiment import load_record
     from ..fit import fit as run_fit
@@ -342,8 +343,12 @@ def fit(
     res = run_fit(sc, meas, paths, bounds=bnds, point=x, excitation=trace, hold=hold,  # type: ignore[arg-type]
                   window=win, max_nfev=max_nfev, conf_interval=conf_interval)
     written: list[Path] = []
-    failure: WriteError | None = None
-    if out is not None:
+    failure: ImpactBeamError | None = None
+    if not res.success:  # a failed computation: status 1, and no "fitted" scenario written
+        failure = ImpactBeamError(
+            f"the fit did not converge ({res.message}): its values are not a least-squares minimum"
+            + (f"; {out} not written" if out is not None else "") + "; raise --max-nfev or narrow --bounds")
+    elif out is not None:
         try:
             written = res.write_scenario(out)
         except WriteError as exc:  # reported after the fitted values, so they are not lost

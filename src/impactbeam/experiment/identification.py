@@ -243,24 +243,24 @@ def identify(
     if record.quantity != "deflection":
         raise ParameterError(f"{record.label}: identification needs a deflection record, got an acceleration")
     _require_oscillation(record)
+    _warn_clipped(record)
     fe = identify_frequencies(record, count)
     freqs = [float(f) for f in fe.frequencies_hz]
     damping = _damping(record, freqs)
+    _warn_disagreement(record, damping)
     model: dict[str, Any] = {}
     updates: dict[str, float] = {}
     if scenario is not None:
         from ..modal import mode_set
 
-        d0 = damping[0]  # the spectral peak is the damped frequency; corrected by a damping the fit resolves
-        sure = math.isfinite(d0.fit) and 0 <= d0.fit < 1 and d0.fit_standard_error < 0.5 * d0.fit
-        xi1 = d0.fit if sure else 0.0
-        f1n = freqs[0] / math.sqrt(1.0 - xi1**2)
+        f1n = freqs[0] / math.sqrt(1.0 - _resolved_damping(damping[0]) ** 2)
         ms0 = mode_set(scenario.beam, (), scenario.solver.modes)
-        mode = _model_mode(record, f1n, ms0.frequencies_hz[ms0.n_rigid:])
+        mode = _model_mode(record, freqs[0], f1n, ms0.frequencies_hz[ms0.n_rigid:])
         e_new = modulus_from_frequency(scenario, f1n, mode=mode)
         updates["beam.youngs_modulus"] = e_new
         sc_e = scenario.with_values({"beam.youngs_modulus": e_new})
         ms1 = mode_set(sc_e.beam, (), scenario.solver.modes)
+        _warn_aliases(record, freqs, ms1.frequencies_hz[ms1.n_rigid:], fe.resolution_hz)
         model.update({
             "natural_frequency_hz": f1n,
             "mode": mode,
@@ -292,7 +292,104 @@ def identify(
     return Identification(record=record, frequencies=fe, damping=damping, model=model, updates=updates)
 
 
-def _model_mode(record: Record, f: float, model_hz: np.ndarray) -> int:
+def _resolved_damping(d: ModeDamping) -> float:
+    """The damping that corrects the first mode's damped frequency: the fit's, when it is resolved, else 0.
+
+    Resolved: a ratio in [0, 1) with a standard error under half of it, which
+    the matrix pencil confirms within half of it too. On a record of about
+    one cycle the fit can land on a large damping with a standard error just
+    under half of it (71 +/- 30 % against the pencil's 0.97 % on 20 ms of a
+    61 Hz decay), and its correction would raise the frequency 1.4 times and
+    the modulus twice.
+    """
+    fit, se, pencil = d.fit, d.fit_standard_error, d.pencil
+    if not (math.isfinite(fit) and 0.0 <= fit < 1.0 and se < 0.5 * fit):
+        return 0.0
+    if math.isfinite(pencil) and abs(fit - pencil) > 0.5 * fit:
+        return 0.0
+    return fit
+
+
+#: Fit and pencil disagreeing by more than this many standard errors of the fit, and by more than
+#: DISAGREE_RELATIVE of the fit, are warned about (:func:`_warn_disagreement`).
+DISAGREE_ERRORS = 5.0
+DISAGREE_RELATIVE = 0.05
+
+
+def _warn_disagreement(record: Record, damping: tuple[ModeDamping, ...]) -> None:
+    """Warn of modes whose two damping estimates disagree: the record does not follow the model.
+
+    The standard error is the fit's alone, under the model of decaying
+    sines in white noise; a clipped sensor, a mode missing from the count or
+    an alias breaks that model, and the estimates then part by many standard
+    errors (0.709 +/- 0.010 % against the pencil's 1.26 % on a record clipped
+    at its rails, the truth 1.0 %).
+    """
+    for k, d in enumerate(damping, start=1):
+        if not (math.isfinite(d.spread) and math.isfinite(d.fit_standard_error)):
+            continue
+        if d.spread > DISAGREE_ERRORS * d.fit_standard_error and d.spread > DISAGREE_RELATIVE * abs(d.fit):
+            emit_user_level_warning(
+                f"{record.label}: mode {k} ({d.frequency_hz:.5g} Hz): the damping fit {100 * d.fit:.4g} +/- "
+                f"{100 * d.fit_standard_error:.2g} % and the matrix pencil {100 * d.pencil:.4g} % differ by "
+                f"{d.spread / d.fit_standard_error:.0f} standard errors: the record does not follow a sum of "
+                "decaying sines in noise (a clipped sensor, a mode missing from the count, an alias, non-linear "
+                "damping), so neither value nor the standard error can be trusted"
+            )
+
+
+def _warn_clipped(record: Record) -> None:
+    """Warn when the record sits at its largest or smallest value in more than one place (a saturated sensor).
+
+    A free decay reaches its extremes once, in its first cycles; a sensor
+    that saturates holds its rail on several cycles (16 % of the samples at
+    +/-1 mm on a 2 mm decay). Clipping biases the damping and adds harmonics
+    that pass for modes (one at 5 f1 was read as mode 2).
+    """
+    v = np.asarray(record.values, dtype=float)
+    for rail, name in ((v.max(), "largest"), (v.min(), "smallest")):
+        at = v == rail
+        runs = int(np.count_nonzero(at[1:] & ~at[:-1]) + at[0])
+        if runs >= 2 and np.count_nonzero(at) >= 4:
+            emit_user_level_warning(
+                f"{record.label}: {np.count_nonzero(at)} samples in {runs} separate places sit exactly at the "
+                f"record's {name} value ({rail:.6g} {record.unit}): a saturated (clipped) sensor; clipping biases "
+                "the damping and adds harmonics of the first mode that pass for modes"
+            )
+
+
+def _warn_aliases(record: Record, freqs: list[float], model_hz: np.ndarray, resolution: float) -> None:
+    """Warn of identified frequencies where a model mode above the Nyquist frequency would appear aliased.
+
+    Sampled at ``fs``, a mode at ``f > fs / 2`` shows at ``|f - n fs|``; its
+    damping is then read ``f / |f - n fs|`` times too high (the decay per
+    second is the true one, the cycles fewer). ``model_hz``: the model's
+    elastic frequencies with the identified modulus; a frequency one of them
+    below the Nyquist frequency explains is not questioned (the high modes'
+    aliases fall anywhere).
+    """
+    fs = record.sample_rate
+
+    def near(a: float, f: float) -> bool:
+        return abs(a - f) <= max(0.03 * f, 3.0 * resolution)
+
+    for k, f in enumerate(freqs, start=1):
+        if any(near(fm, f) for fm in model_hz if fm <= 0.5 * fs):
+            continue  # a mode of the model below the Nyquist frequency explains it
+        for m, fm in enumerate(model_hz, start=1):
+            if fm <= 0.5 * fs:
+                continue
+            if near(abs(fm - fs * round(fm / fs)), f):
+                emit_user_level_warning(
+                    f"{record.label}: mode {k} at {f:.5g} Hz is where the model's mode {m} ({fm:.5g} Hz, above the "
+                    f"Nyquist frequency {0.5 * fs:.5g} Hz of the {fs:.5g} Hz sampling) appears aliased: if it is "
+                    f"that mode, its damping reads {fm / f:.3g} times too high; sample faster or filter "
+                    "(anti-aliasing) before sampling"
+                )
+                break
+
+
+def _model_mode(record: Record, f_damped: float, f: float, model_hz: np.ndarray) -> int:
     """The model's elastic mode (1, 2, ...) nearest ``f`` in ratio, warned when it is not the first.
 
     The record's lowest identified frequency is taken for the first mode; on a
@@ -313,7 +410,8 @@ def _model_mode(record: Record, f: float, model_hz: np.ndarray) -> int:
     mode = int(np.argmin(np.abs(np.log(model_hz / f)))) + 1
     if mode != 1:
         emit_user_level_warning(
-            f"{record.label}: the lowest identified frequency, {f:.5g} Hz, is nearest the model's mode {mode} "
+            f"{record.label}: the lowest identified frequency, {f_damped:.5g} Hz ({f:.5g} Hz undamped), is nearest "
+            f"the model's mode {mode} "
             f"({model_hz[mode - 1]:.5g} Hz), not its first ({model_hz[0]:.5g} Hz): the modulus is taken from "
             f"mode {mode}; a longer record or a larger count finds the first"
         )

@@ -193,7 +193,7 @@ def _value_scale(unit: str, label: str, where: str) -> tuple[float, Quantity]:
             problems.append(str(exc).partition(": ")[2])
     raise ScenarioError(
         f'{label}: {where}: unit "{unit}" is neither a length (deflection) nor an acceleration '
-        f"({problems[0]})",
+        f"({problems[0]}; as an acceleration: {problems[1]})",
         key="record",
     )
 
