@@ -226,3 +226,20 @@ def test_a_record_in_milli_g_is_told_how_g_is_read(tmp_path: Path) -> None:
     path.write_text("time [s],acceleration (mg)\n" + "\n".join(f"{i * 1e-3},{(-1) ** i}" for i in range(12)))
     with pytest.raises(ScenarioError, match=r'as an acceleration: .*"mg" is a milligram'):
         ex.load_record(path)
+
+
+def test_a_record_in_the_wrong_units_is_warned_about_before_a_comparison_or_fit() -> None:
+    # Found by a hunt: under unit-less headers a deflection in mm was read in m (a 1.08 m peak on a 0.109 m beam)
+    # and a time in ms in s (compare then simulated 120 s of a record "sampled at 2 Hz"), without a word
+    from impactbeam.experiment.compare import prepare_run
+
+    sc = ib.load_scenario(ROOT / "examples" / "case03.toml")
+    t = np.arange(0.0, 0.06, 5e-4)
+    w = 1e-3 * np.sin(2 * np.pi * 57.0 * t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        prepare_run(sc, ex.Record(t, w, name="right"), None, "linear", None)
+    with pytest.warns(ib.ImpactBeamWarning, match=r"more than half the beam's length \(0.1092 m\)"):
+        prepare_run(sc, ex.Record(t, 1e3 * w, name="mm as m"), None, "linear", None)
+    with pytest.warns(ib.ImpactBeamWarning, match=r"sampled at 2 Hz, below twice the beam's first frequency"):
+        prepare_run(sc, ex.Record(1e3 * t, w, name="ms as s"), None, "linear", None)

@@ -343,7 +343,31 @@ def prepare_run(
     if t_end <= 0:
         raise ParameterError(f"{measured.label}: no samples after t = 0")
     sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time=t_end))
+    _warn_implausible(sc, meas)
     return sc, meas
+
+
+def _warn_implausible(scenario: Scenario, record: Record) -> None:
+    """Warn of a deflection record whose units look wrong for the beam: a peak over half its length, or a
+    sampling below twice its first free frequency (mm read as m, ms read as s, under unit-less headers)."""
+    from .._warnings import emit_user_level_warning
+    from ..modal import mode_set
+
+    length = scenario.beam.length
+    peak = float(np.max(np.abs(record.values)))
+    if peak > 0.5 * length:
+        emit_user_level_warning(
+            f"{record.label}: its largest deflection, {peak:.4g} m, is more than half the beam's length "
+            f"({length:.4g} m): is its unit right (a header without one is read in m)?"
+        )
+    ms = mode_set(scenario.beam, (), 4)
+    elastic = ms.frequencies_hz[ms.n_rigid:]
+    if elastic.size and record.sample_rate < 2.0 * elastic[0]:
+        emit_user_level_warning(
+            f"{record.label}: sampled at {record.sample_rate:.4g} Hz, below twice the beam's first frequency "
+            f"({elastic[0]:.4g} Hz): the record cannot follow the response (is its time unit right? a header "
+            "without one is read in s)"
+        )
 
 
 def compare(
