@@ -404,3 +404,12 @@ def test_time_averages_of_an_over_damped_beam_against_the_closed_form():
     v_coef = np.vstack([np.zeros((1, W.shape[1])), -(r1 * a)[:, None] * Ws, -(r2 * b)[:, None] * Ws])
     assert np.asarray(stats["mean_square"]) == pytest.approx(mean_square(w_coef), rel=2e-3)
     assert np.asarray(stats["velocity_mean_square"]) == pytest.approx(mean_square(v_coef), rel=2e-3)
+
+
+def test_an_ensembles_progress_says_ensemble(capsys):
+    # the progress of `impactbeam random` was labelled "sweep" (the ensemble runs as a sweep over the stream)
+    sc = ib.parse_scenario(linear_data(end_time=0.2))
+    with pytest.warns(ib.ImpactBeamWarning):  # a 0.2 s record: its statistics include the start from rest
+        ib.random_response(sc, seeds=2, workers=0, progress=True)
+    err = capsys.readouterr().err
+    assert "ensemble" in err and "sweep" not in err, err

@@ -257,7 +257,7 @@ def random_response(
         samples=None, seed=None, metrics=(), histories=None, source=scenario.source,
         name=f"random ensemble of {scenario.name}", statistics=True,
     )
-    run = run_sweep(spec, store, workers=workers, scheduler=scheduler, progress=progress)
+    run = run_sweep(spec, store, workers=workers, scheduler=scheduler, progress=progress, label="ensemble")
     ds = run.dataset.load()
     est = _aggregate(ds, float(confidence), scenario.fatigue is not None)
     warnings: list[str] = []

@@ -200,6 +200,7 @@ def run_sweep(
     batch_size: int | None = None,
     progress: bool = True,
     on_error: Literal["record", "raise"] = "record",
+    label: str = "sweep",
 ) -> SweepRun:
     """Run (or resume) a sweep; like :func:`sweep` but returns a :class:`SweepRun` with counts.
 
@@ -217,6 +218,8 @@ def run_sweep(
         Cases per batch (one Zarr chunk).
     progress : bool
         Show progress on stderr (a bar on a terminal, lines into a file or a pipe).
+    label : str
+        What the progress calls the study ("ensemble" for a random ensemble).
     on_error : {"record", "raise"}
         Record a failed case (status -1) or raise.
     """
@@ -239,7 +242,7 @@ def run_sweep(
         _check_store_path(out_path)
     try:
         with _StoreLock(out_path):
-            return _run_locked(spec, out_path, chunk, workers, scheduler, progress, on_error)
+            return _run_locked(spec, out_path, chunk, workers, scheduler, label if progress else "", on_error)
     except OSError as exc:  # a read-only or full file system: one line; finished batches stay in the store
         err = write_error(out_path or "the sweep", exc)
         raise WriteError(err.path, f"{err.reason} (the batches finished before are kept in the store; "
@@ -268,8 +271,8 @@ def _check_in_memory(spec: SweepSpec) -> None:
 
 
 def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], workers: int | None,
-                scheduler: str | None, progress: bool, on_error: str) -> SweepRun:
-    """:func:`run_sweep` once the store is ours."""
+                scheduler: str | None, progress: str, on_error: str) -> SweepRun:
+    """:func:`run_sweep` once the store is ours; ``progress`` the label of its progress ("" for none)."""
     fresh = not (out_path is not None and out_path.exists()
                  and not (out_path.is_dir() and not any(out_path.iterdir())))
     local = maker = None
@@ -294,8 +297,8 @@ def _run_locked(spec: SweepSpec, out_path: Path | None, chunk: tuple[int, ...], 
             skipped = int((status != NOT_RUN).sum())
             n_todo = spec.n_cases - skipped
 
-            bar = Progress(spec.n_cases, desc="sweep", unit="case", enabled=progress, done=spec.n_cases - n_todo,
-                           after=0.0, dynamic_ncols=True)
+            bar = Progress(spec.n_cases, desc=progress or "sweep", unit="case", enabled=bool(progress),
+                           done=spec.n_cases - n_todo, after=0.0, dynamic_ncols=True)
 
             def done(region: tuple[tuple[int, int], ...], res: Mapping[str, Any]) -> None:
                 n, written = len(res["status"]), False
