@@ -349,3 +349,26 @@ def test_the_bending_moment_holds_a_dashpots_force(law):
     paper = moments("paper", 8)
     clamp, stop = np.abs(paper - reference).max(axis=1) / np.abs(reference).max(axis=1)
     assert stop <= 2e-4 and clamp <= 1e-3
+
+
+def test_a_preload_amplitude_is_an_acceleration_in_studies_fits_and_diagrams():
+    # Found by a hunt: sweeps, fits and bifurcation diagrams read preload.amplitude as a dimensionless number
+    # (path_dimension without the preload's kind): "-1 g" was refused as a mass and "-980.665 %" taken as
+    # -9.80665 m/s^2. They now ask the scenario (Scenario.path_dimension), as its parser does.
+    from impactbeam.fit.parameters import parse_bounds
+    from impactbeam.periodic.bifurcation import parameter_values
+    from impactbeam.sweeps import parse_sweep
+
+    root = Path(__file__).resolve().parents[1] / "examples"
+    data = dict(ib.load_scenario(root / "periodic" / "specimen_harmonic.toml").data)
+    data["preload"] = {"kind": "gravity", "amplitude": "-1 g"}
+    sc = ib.parse_scenario(data, base_dir=root / "periodic")
+    g = 9.80665
+    assert sc.path_dimension("preload.amplitude") == "acceleration"
+    assert parameter_values("preload.amplitude", sc, ["-1 g", "-9.80665 m/s^2", -2.0]) == [-g, -g, -2.0]
+    with pytest.raises(ib.ScenarioError, match="expected an acceleration"):
+        parameter_values("preload.amplitude", sc, ["-980.665 %"])
+    assert parse_bounds(["preload.amplitude=-2 g:0 g"], *sc.load_kinds) == {"preload.amplitude": (-2 * g, 0.0)}
+    spec = parse_sweep({"base": data, "parameters": {"preload.amplitude": {"range": ["-1 g", "-3 g", 3]}}},
+                       base_dir=root / "periodic")
+    np.testing.assert_allclose(spec.parameters[0].values, [-g, -2 * g, -3 * g], rtol=1e-15)

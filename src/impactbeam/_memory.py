@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 
 from .exceptions import ParameterError, ResourceError
 
@@ -37,18 +38,28 @@ def sample_count(end_time: float, time_step: float) -> int:
     return int(math.floor(end_time / time_step * (1.0 + 1e-12))) + 1
 
 
+_SIZE = re.compile(r"^([0-9.]+(?:E[+-]?[0-9]+)?)\s*([KMG]?)(?:I?B)?$")
+
+
 def _size(name: str, default: float) -> float:
-    """The number in environment variable ``name`` (a ``K``, ``M`` or ``G`` suffix allowed), else ``default``."""
+    """The number in environment variable ``name``, else ``default``.
+
+    A ``K``, ``M`` or ``G`` suffix multiplies by 2^10, 2^20 or 2^30, with or
+    without a ``B`` or ``iB`` after it (``4G``, ``4GB``, ``4 GiB``); a bare
+    ``B`` is bytes.
+    """
     raw = os.environ.get(name, "").strip().upper()
     if not raw:
         return default
-    mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(raw[-1:], 1)
-    try:
-        value = float(raw.rstrip("KMGB") or "nan") * mult
-    except ValueError:
-        value = math.nan
+    m = _SIZE.match(raw)
+    value = math.nan
+    if m is not None:
+        try:
+            value = float(m.group(1)) * {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "": 1}[m.group(2)]
+        except ValueError:
+            pass
     if not value > 0:
-        raise ParameterError(f"{name}: not a positive size: {raw!r}")
+        raise ParameterError(f"{name}: not a positive size: {raw!r} (a number, optionally with K, M or G: 4G, 4GB)")
     return value
 
 

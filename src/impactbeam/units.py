@@ -280,7 +280,14 @@ def _parse_unit(unit: str, dimension: str, shown: str) -> Any:
             f'cannot read "{shown}": "{unit}" is not a unit ({detail}); expected one number (a decimal point, '
             f"no separators) and a unit, {describe_dimension(dimension)}"
         ) from None
-    return ureg.Quantity(1.0, units)
+    quantity = ureg.Quantity(1.0, units)
+    if not quantity._is_multiplicative:  # dB, octave, decade, degC: a number in them is not a multiple of a unit
+        raise _UnitProblem(
+            f'cannot read "{shown}": "{unit}" is a logarithmic or offset unit, not a multiple of one (a value in it '
+            f"is not that many units); give the value as a plain number or in a multiplicative unit, "
+            f"{describe_dimension(dimension)}"
+        )
+    return quantity
 
 
 #: SI factors of the units most scenario files use, so that reading them needs no

@@ -113,7 +113,7 @@ def fit(
 
     from ..simulation import simulate
 
-    paths, user_bounds = _checked_params(params, bounds, max_nfev, scenario.excitation.kind)
+    paths, user_bounds = _checked_params(params, bounds, max_nfev, scenario)
     base, meas = prepare_run(scenario, measured, None, hold, window)
     override = _excitation_override(base, excitation, hold)
     # base.data drives with_values: keep the end time there too
@@ -187,7 +187,7 @@ def fit(
 
 
 def _checked_params(
-    params: Sequence[str] | str, bounds: Any, max_nfev: int, kind: str
+    params: Sequence[str] | str, bounds: Any, max_nfev: int, scenario: Scenario
 ) -> tuple[tuple[str, ...], dict[str, tuple[float, float]]]:
     """The fitted paths and the user's bounds, checked (see :func:`fit`)."""
     if isinstance(params, str):
@@ -199,7 +199,7 @@ def _checked_params(
         raise ParameterError(f"params: a path is listed twice ({', '.join(paths)})")
     if isinstance(max_nfev, bool) or int(max_nfev) != max_nfev or max_nfev < 1:
         raise ParameterError(f"max_nfev: must be a positive integer, got {max_nfev!r}")
-    user_bounds = parse_bounds(bounds, kind) if bounds is not None else {}
+    user_bounds = parse_bounds(bounds, *scenario.load_kinds) if bounds is not None else {}
     for p in user_bounds:
         if p not in paths:
             raise ParameterError(f"bounds {p}: not among the fitted params ({', '.join(paths)})")

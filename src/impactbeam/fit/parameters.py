@@ -89,7 +89,7 @@ def _default_bounds(path: str, x0: float) -> tuple[float, float]:
 
 
 def parse_bounds(
-    items: Sequence[str] | Mapping[str, Any], kind: str = "base_acceleration"
+    items: Sequence[str] | Mapping[str, Any], kind: str = "base_acceleration", preload_kind: str | None = None
 ) -> dict[str, tuple[float, float]]:
     """Bounds from ``["PATH=LO:HI", ...]`` (either end may be empty; values SI or with units).
 
@@ -101,6 +101,8 @@ def parse_bounds(
         (:func:`impactbeam.scenario.path_dimension`).
     kind : str
         ``excitation.kind`` of the scenario (the dimension of ``excitation.amplitude``).
+    preload_kind : str, optional
+        ``preload.kind`` of the scenario (the dimension of ``preload.amplitude``).
 
     Returns
     -------
@@ -126,7 +128,7 @@ def parse_bounds(
         if not eq or not colon or not path.strip():
             raise ParameterError(f'--bounds: "{item}" is not of the form PATH=LO:HI')
         path = path.strip()
-        dim = path_dimension(path, kind)
+        dim = path_dimension(path, kind, preload_kind)
         dim = "dimensionless" if dim in (None, "integer") else dim
         vals = []
         for text, default in ((lo_s, -math.inf), (hi_s, math.inf)):

@@ -164,9 +164,7 @@ class BifurcationDiagram:
 
 def _dimension(parameter: str, scenario: Scenario) -> str:
     """The dimension a value of ``parameter`` is read in (:func:`impactbeam.scenario.path_dimension`)."""
-    from ..scenario import path_dimension
-
-    dim = path_dimension(parameter, scenario.excitation.kind)
+    dim = scenario.path_dimension(parameter)
     return "dimensionless" if dim in (None, "integer") else dim
 
 

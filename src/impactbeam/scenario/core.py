@@ -109,6 +109,28 @@ class Scenario:
                     table[key] = str(path if path.is_absolute() else (Path(self.base_dir) / path).resolve())
         return scenario_toml(data)
 
+    def path_dimension(self, path: str) -> str | None:
+        """The dimension a value at the dotted ``path`` is read in, this scenario's kinds of load given.
+
+        :func:`~impactbeam.scenario.schema.path_dimension` with ``excitation.kind``
+        and ``preload.kind`` (the dimensions of their amplitudes): what sweeps,
+        fits and bifurcation diagrams read their values in.
+
+        Parameters
+        ----------
+        path : str
+            A dotted path of the schema (``"contactors.0.gap"``, ``"preload.amplitude"``).
+        """
+        from .schema import path_dimension
+
+        return path_dimension(path, *self.load_kinds)
+
+    @property
+    def load_kinds(self) -> tuple[str, str | None]:
+        """``(excitation.kind, preload.kind)``, None for the second without a ``[preload]``: what the
+        amplitudes' dimensions follow."""
+        return self.excitation.kind, None if self.preload is None else self.preload.kind
+
     @property
     def description(self) -> str | None:
         """The ``description`` string of the file, if any."""

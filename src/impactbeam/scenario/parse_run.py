@@ -73,8 +73,27 @@ def _parse_damping(raw: Mapping[str, Any]) -> Damping:
             )
     alpha = _nonnegative("damping.alpha", d.get("alpha", 0.0), "rate")
     beta = _nonnegative("damping.beta", d.get("beta", 0.0), "time")
+    for key in ("free", "contact"):
+        _warn_percent_as_ratio(f"damping.{key}", d.get(key))
     with _relabel("damping"):
         return Damping(_ratios(d, "free"), _ratios(d, "contact"), model, alpha, beta)  # type: ignore[arg-type]
+
+
+def _warn_percent_as_ratio(key: str, value: Any) -> None:
+    """Warn of a damping ratio of 1 or more written as a bare number: a percentage meant as a ratio?
+
+    The paper gives its damping in percent (1.1 %); ``free = 1.1`` is a ratio
+    of 110 % of critical, which stops the beam from ringing at all.
+    """
+    from .._warnings import emit_user_level_warning
+
+    values = value if isinstance(value, list) else [value]
+    large = [v for v in values if isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 1.0]
+    if large:
+        emit_user_level_warning(
+            f"{key}: {large[0]:g} is read as a ratio, {100 * large[0]:g} % of critical (at or above critical: "
+            f'no ringing); if {large[0]:g} % was meant, write "{large[0]:g} %" or {large[0] / 100:g}'
+        )
 
 
 def _reject_unused(table: Mapping[str, Any], names: tuple[str, ...], why: str) -> None:

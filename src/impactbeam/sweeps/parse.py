@@ -13,7 +13,7 @@ import numpy as np
 from ..exceptions import ScenarioError
 from ..result.metrics import METRIC_UNITS
 from ..result.simulation_result import STRESS_METRIC_UNITS
-from ..scenario import Scenario, load_scenario, parse_scenario, path_dimension
+from ..scenario import Scenario, load_scenario, parse_scenario
 from ..scenario.schema import describe_value
 from ..units import to_si
 from .spec import DESIGNS, DISTRIBUTIONS, Histories, SweepParameter, SweepSpec
@@ -30,7 +30,7 @@ _HISTORY_KEYS = ("points", "time_step")
 def _dimension_of(path: str, base: Scenario) -> str | None:
     """The dimension of a swept path (None for a path outside the schema: reported when checked)."""
     try:
-        return path_dimension(path, base.excitation.kind)
+        return base.path_dimension(path)
     except ScenarioError:
         return None
 
