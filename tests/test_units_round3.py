@@ -56,3 +56,14 @@ def test_a_damping_ratio_of_one_or_more_as_a_bare_number_is_warned_about():
     with warnings.catch_warnings():  # a percentage written as one, and ratios below 1, say nothing
         warnings.simplefilter("error")
         sc.with_values({"damping.free": "110 %", "damping.contact": 0.5})
+
+
+def test_the_linear_frf_reads_frequencies_with_units():
+    # ib.linear_frf(sc, ["60 Hz"]) raised a bare ValueError: strings with units are read as everywhere else
+    import numpy as np
+
+    sc = ib.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "periodic" / "specimen_harmonic.toml")
+    # "3600 rpm" is 60 Hz to the unit factor's 15 digits (1/60 rounded): 2e-15 of the frequency, 4e-14 here
+    np.testing.assert_allclose(ib.linear_frf(sc, ["60 Hz", "3600 rpm"]), ib.linear_frf(sc, [60.0, 60.0]), rtol=1e-12)
+    with pytest.raises(ib.ParameterError, match=r"frequencies \(value 1\)"):
+        ib.linear_frf(sc, ["60 mm"])

@@ -54,7 +54,7 @@ def _free_state(scenario: Scenario) -> tuple[Any, Any]:
     return pk, opt
 
 
-def linear_frf(scenario: Scenario, frequencies: Sequence[float] | np.ndarray,
+def linear_frf(scenario: Scenario, frequencies: Sequence[float | str] | np.ndarray,
                points: Sequence[float] | None = None) -> np.ndarray:
     """Complex amplitude of ``w`` per unit load amplitude, without contact (module docstring).
 
@@ -64,6 +64,7 @@ def linear_frf(scenario: Scenario, frequencies: Sequence[float] | np.ndarray,
         Its beam, damping, load distribution (``excitation.kind``) and modes
         (``solver.modes = "auto"`` is read as 8); contactors are kept open.
     frequencies : array_like, [Hz]
+        Numbers in Hz, or strings with units (``"60 Hz"``, ``"3600 rpm"``).
     points : sequence of float, optional, [m]
         Default: the strobe point (first contactor, else first output point).
 
@@ -84,6 +85,10 @@ def linear_frf(scenario: Scenario, frequencies: Sequence[float] | np.ndarray,
     if x.ndim != 1 or bad.any():
         shown = x[bad][0] if x.ndim == 1 else x
         raise ParameterError(f"points: {shown} m is not a position on the beam [0, {L:g}] m (a 1-D list)")
+    if not isinstance(frequencies, np.ndarray) and any(isinstance(v, str) for v in np.ravel(frequencies)):
+        from ..units import to_si  # strings with units, as everywhere else ("60 Hz", "3600 rpm")
+
+        frequencies = [to_si(v, "frequency", f"frequencies (value {i + 1})") for i, v in enumerate(frequencies)]
     f = np.asarray(frequencies, dtype=float)
     if f.ndim > 1 or not np.all(np.isfinite(f)) or np.any(f < 0.0):
         raise ParameterError("frequencies: expected finite frequencies >= 0 [Hz] in a 1-D list")
