@@ -67,3 +67,13 @@ def test_the_linear_frf_reads_frequencies_with_units():
     np.testing.assert_allclose(ib.linear_frf(sc, ["60 Hz", "3600 rpm"]), ib.linear_frf(sc, [60.0, 60.0]), rtol=1e-12)
     with pytest.raises(ib.ParameterError, match=r"frequencies \(value 1\)"):
         ib.linear_frf(sc, ["60 mm"])
+
+
+def test_a_selection_of_a_ratio_takes_a_percentage():
+    # plot --sel "damping.free=2 %" was refused (a dimensionless coordinate had no dimension to read it in)
+    from impactbeam.plot.sweep import _in_si
+
+    assert _in_si("2 %", "damping.free", "1") == pytest.approx(0.02, rel=1e-15)
+    assert _in_si("2 %", "excitation.scale", "") == pytest.approx(0.02, rel=1e-15)
+    with pytest.raises(ib.ParameterError, match=r"--sel damping\.free"):
+        _in_si("2 mm", "damping.free", "1")

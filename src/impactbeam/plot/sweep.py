@@ -174,7 +174,8 @@ def _in_si(value: Any, dim: str, unit: str) -> float:
         pass
     from ..units import DIMENSIONS, to_si
 
-    dimension = next((name for name, d in DIMENSIONS.items() if unit and d.si_unit == unit), None)
+    dimension = "dimensionless" if unit in ("", "1") else next(
+        (name for name, d in DIMENSIONS.items() if d.si_unit == unit), None)  # "2 %" for a ratio too
     if dimension is None or not isinstance(value, str):
         raise ParameterError(f"--sel {dim}: expected a number{f' [{unit}]' if unit else ''}, got {value!r}")
     return to_si(value, dimension, f"--sel {dim}")
