@@ -12,11 +12,12 @@ import numpy as np
 from .._warnings import WarningLog
 from ..result.metrics import contact_intervals
 from ..scenario import Scenario, parse_scenario
+from ..units import STANDARD_GRAVITY
 
 __all__ = ["SLIDERS", "ExplorerModel", "Slider", "contact_spans", "curves", "envelope", "envelope_index",
            "padded_range"]
 
-G = 9.80665  # standard gravity [m/s^2], for base accelerations shown in g
+G = STANDARD_GRAVITY  # [m/s^2], for base accelerations shown in g
 
 
 @dataclass(frozen=True)
