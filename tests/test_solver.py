@@ -486,6 +486,9 @@ def test_chattering_guard_stops_counts_and_says_so(method):
     t_stop = r.events[-1].time
     after = r.time > t_stop + 1e-5
     assert np.isnan(r.w[after]).all() and np.isfinite(r.w[~after][:-1]).all()
+    # every energy after the stop is NaN too (the contactor's read 0 J, found by a hunt), finite before it
+    for name, series in r.energy.items():
+        assert np.isnan(series[after]).all() and np.isfinite(series[~after][:-1]).all(), name
     m = r.metrics()
     assert m["n_events"] == 5
 

@@ -77,3 +77,16 @@ def test_a_selection_of_a_ratio_takes_a_percentage():
     assert _in_si("2 %", "excitation.scale", "") == pytest.approx(0.02, rel=1e-15)
     with pytest.raises(ib.ParameterError, match=r"--sel damping\.free"):
         _in_si("2 mm", "damping.free", "1")
+
+
+def test_a_random_history_too_long_for_memory_names_the_end_time():
+    # the refusal named excitation.duration, a key a random load refuses; the history's length is set by
+    # solver.end_time (from excitation.start)
+    sc = ib.parse_scenario({
+        "beam": {"length": 0.1092, "width": 9.93e-3, "height": 3.03e-3, "youngs_modulus": 1834e6, "density": 951.98},
+        "excitation": {"kind": "base_acceleration", "shape": "random", "seed": 1,
+                       "psd": [["10 Hz", "0.01 g^2/Hz"], ["1000 Hz", "0.01 g^2/Hz"]]},
+        "solver": {"modes": 2, "end_time": 1.0}})
+    with pytest.raises(ib.ParameterError, match=r"^excitation\.sample_rate: .*\(from excitation\.start to "
+                                                r"solver\.end_time.*shorter history \(solver\.end_time\)"):
+        sc.with_values({"solver.end_time": 1e6, "solver.time_step": 1.0})

@@ -251,8 +251,9 @@ def synthesize(
     fs = sample_rate(psd, rate)
     from .._memory import check_memory
 
-    check_memory(T * fs * SAMPLE_BYTES, f"excitation.sample_rate: {fs:g} Hz over excitation.duration = {T:g} s "
-                 f"({T * fs:.3g} load samples)", "ask for a lower sample rate or a shorter history")
+    check_memory(T * fs * SAMPLE_BYTES, f"excitation.sample_rate: {fs:g} Hz over a history of {T:g} s (from "
+                 f"excitation.start to solver.end_time; {T * fs:.3g} load samples)",
+                 "ask for a lower sample rate or a shorter history (solver.end_time)")
     n = max(int(math.ceil(T * fs)), 4)
     n += n % 2
     f_lo, f_hi = psd.band

@@ -329,6 +329,7 @@ class SimulationResult:
             on = self.engaged[:, i]
             contactor_energy += np.where(on, 0.5 * c.stiffness * g**2, 0.0)
             spring_at_zero_gap += np.where(on, 0.5 * c.stiffness * wc**2, 0.0)
+        contactor_energy[np.isnan(kinetic)] = np.nan  # after a stop by the chattering guard, as every sample
         strain = modal_strain - spring_at_zero_gap
         total = kinetic + strain + contactor_energy
         input_work, dissipated, dashpot_work = cumulative_power(self, self.time).T  # exact, not the output grid's
