@@ -92,6 +92,30 @@ def test_reproduce_stops_on_signal(tmp_path, sig, code):
     assert not (out / "report.html").exists() and not (out / "report.md").exists()
 
 
+def test_an_error_raised_while_an_interrupt_unwinds_still_ends_as_the_interrupt(tmp_path, monkeypatch):
+    # Found by a CI rehearsal of test_reproduce_stops_on_signal: a SIGINT inside matplotlib's savefig of a PDF
+    # made its clean-up raise AttributeError ('Stream' object has no attribute 'pos'), and reproduce ended with
+    # status 1 and a traceback. An error whose context holds the interrupt now ends as the interrupt does.
+    from click.testing import CliRunner
+
+    import impactbeam.paper as paper
+    from impactbeam.cli import main
+
+    def interrupted_while_saving(*args, **kwargs):
+        try:
+            raise KeyboardInterrupt
+        finally:
+            raise AttributeError("'Stream' object has no attribute 'pos'")  # noqa: B012 - the library's clean-up
+
+    monkeypatch.setattr(paper, "reproduce", interrupted_while_saving)
+    r = CliRunner().invoke(main, ["reproduce", "--out", str(tmp_path / "paper")], catch_exceptions=False)
+    assert r.exit_code == 130 and r.stderr.startswith("interrupted (SIGINT)"), r.output
+    # an error without an interrupt behind it stays an error
+    monkeypatch.setattr(paper, "reproduce", lambda *a, **k: (_ for _ in ()).throw(AttributeError("plain")))
+    with pytest.raises(AttributeError, match="plain"):
+        CliRunner().invoke(main, ["reproduce", "--out", str(tmp_path / "paper")], catch_exceptions=False)
+
+
 def test_memory_capped_run_is_refused_up_front(tmp_path):
     # with a 2 GiB address-space limit, 20 s sampled at 1e-6 s with modal coordinates
     # (~5 GB) must be refused with the estimate (exit 2), not crash allocating

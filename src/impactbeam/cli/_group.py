@@ -295,11 +295,39 @@ class _Commands(click.Group):
         except click.UsageError as exc:  # a command's options and arguments, or an unknown command
             _usage_error(exc)
         except KeyboardInterrupt as exc:
-            signum = int(getattr(exc, "signum", _received[0] if _received else signal.SIGINT))
-            _handled()
-            click.echo(f"interrupted ({signal.Signals(signum).name}): stopped; finished files are kept, "
-                       "nothing half-written", err=True)
-            sys.exit(128 + signum)
+            _stop(exc)
+        except Exception as exc:
+            interrupt = _interrupt_behind(exc)
+            if interrupt is None:
+                raise
+            _stop(interrupt)
+
+
+def _interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
+    """The interruption an error was raised while handling, if any (its ``__context__`` chain).
+
+    A library's clean-up can fail under a Ctrl-C and replace it: matplotlib's
+    PDF writer, interrupted inside ``savefig``, raised an AttributeError while
+    closing a stream the interrupt had left half-made, and the command ended
+    with status 1 and a traceback instead of 130.
+    """
+    seen: set[int] = set()
+    link: BaseException | None = exc
+    while link is not None and id(link) not in seen:
+        if isinstance(link, KeyboardInterrupt):
+            return link
+        seen.add(id(link))
+        link = link.__context__
+    return None
+
+
+def _stop(exc: KeyboardInterrupt) -> None:
+    """End an interrupted command: one line, finished files kept, status 128 + the signal's number."""
+    signum = int(getattr(exc, "signum", _received[0] if _received else signal.SIGINT))
+    _handled()
+    click.echo(f"interrupted ({signal.Signals(signum).name}): stopped; finished files are kept, "
+               "nothing half-written", err=True)
+    sys.exit(128 + signum)
 
 
 @click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
