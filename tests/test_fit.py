@@ -166,16 +166,22 @@ def test_bounds_are_never_swapped_or_clipped(setup):
     assert current_value(base, "beam.youngs_modulus") == 1834e6
 
 
-def test_cli_fit_json(setup, tmp_path):
-    """`impactbeam fit --json --bounds --out` (subprocess): JSON keys, bounds kept
-    as given, fitted values within 2 %, the fitted scenario written."""
-    base, trace, meas = setup
+def _record_files(setup, tmp_path):
+    """The measured deflection (mm) and base acceleration (g) of ``setup`` as CSV files with unit headers."""
+    _, trace, meas = setup
     mp = tmp_path / "defl.csv"
     mp.write_text("time [s],deflection [mm]\n" + "\n".join(
         f"{float(a)!r},{float(b) * 1e3!r}" for a, b in zip(meas.time, meas.values)))
     tp = tmp_path / "acc.csv"
     tp.write_text("time [s],acceleration [g]\n" + "\n".join(
         f"{float(a)!r},{float(b) / G!r}" for a, b in zip(trace.time, trace.values)))
+    return mp, tp
+
+
+def test_cli_fit_json(setup, tmp_path):
+    """`impactbeam fit --json --bounds --out` (subprocess): JSON keys, bounds kept
+    as given, fitted values within 2 %, the fitted scenario written."""
+    mp, tp = _record_files(setup, tmp_path)
     out = tmp_path / "fit.toml"
     proc = subprocess.run(
         [str(CLI), "fit", str(EXAMPLES / "case03.toml"), str(mp), "--excitation", str(tp),
@@ -195,13 +201,7 @@ def test_cli_fit_json(setup, tmp_path):
 def test_cli_fit_that_does_not_converge_exits_1_and_writes_nothing(setup, tmp_path):
     """Found by a hunt: with --max-nfev 3 the fit stopped unconverged, exited 0 and wrote a "fitted" scenario
     (k = 5416 N/m where the truth is 5200). A failed computation exits 1: the report, then one error line."""
-    base, trace, meas = setup
-    mp = tmp_path / "defl.csv"
-    mp.write_text("time [s],deflection [mm]\n" + "\n".join(
-        f"{float(a)!r},{float(b) * 1e3!r}" for a, b in zip(meas.time, meas.values)))
-    tp = tmp_path / "acc.csv"
-    tp.write_text("time [s],acceleration [g]\n" + "\n".join(
-        f"{float(a)!r},{float(b) / G!r}" for a, b in zip(trace.time, trace.values)))
+    mp, tp = _record_files(setup, tmp_path)
     out = tmp_path / "fit.toml"
     proc = subprocess.run(
         [str(CLI), "fit", str(EXAMPLES / "case03.toml"), str(mp), "--excitation", str(tp),
